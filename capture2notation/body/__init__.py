@@ -1,0 +1,31 @@
+"""Body model: the joint tree, proportions, extremes and forward kinematics."""
+
+from .frames import body_frame, segment_vectors
+from .kinematics import euler_to_matrix, forward_kinematics, global_rotations, matrix_to_euler
+from .skeleton import (
+    BLAZEPOSE_LANDMARKS,
+    BLAZEPOSE_TO_JOINT,
+    JOINT_INDEX,
+    JOINT_TO_BLAZEPOSE,
+    JOINTS,
+    PARENT,
+    Body,
+    joint_index,
+)
+
+__all__ = [
+    "BLAZEPOSE_LANDMARKS",
+    "BLAZEPOSE_TO_JOINT",
+    "JOINT_INDEX",
+    "JOINT_TO_BLAZEPOSE",
+    "JOINTS",
+    "PARENT",
+    "Body",
+    "body_frame",
+    "euler_to_matrix",
+    "forward_kinematics",
+    "global_rotations",
+    "joint_index",
+    "matrix_to_euler",
+    "segment_vectors",
+]

@@ -1,0 +1,1 @@
+"""End-to-end jobs (render, capture, score, fidelity study) and the ``c2n`` command."""

@@ -1,0 +1,1 @@
+"""One module per ``c2n`` sub-command."""
