@@ -1,0 +1,39 @@
+from pathlib import Path
+
+import pytest
+
+from capture2notation.io.atomic import atomic_path, write_text
+
+
+def test_write_text_replaces_whole_file(tmp_path):
+    p = tmp_path / "sub" / "out.txt"
+    write_text(p, "first")
+    write_text(p, "second")
+    assert p.read_text() == "second"
+    assert [f.name for f in p.parent.iterdir()] == ["out.txt"]
+
+
+def test_failed_write_leaves_no_file_and_no_temp(tmp_path):
+    p = tmp_path / "out.json"
+    with pytest.raises(RuntimeError):
+        with atomic_path(p) as tmp:
+            Path(tmp).write_text("half")
+            raise RuntimeError("boom")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_failed_write_keeps_previous_version(tmp_path):
+    p = tmp_path / "out.txt"
+    write_text(p, "good")
+    with pytest.raises(ValueError):
+        with atomic_path(p) as tmp:
+            Path(tmp).write_text("bad")
+            raise ValueError
+    assert p.read_text() == "good"
+
+
+def test_temp_file_keeps_suffix_for_writers_that_need_it(tmp_path):
+    with atomic_path(tmp_path / "video.mp4") as tmp:
+        assert tmp.suffix == ".mp4"
+        assert tmp.parent == tmp_path
+        tmp.write_bytes(b"x")
