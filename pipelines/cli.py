@@ -17,6 +17,14 @@ from capture2notation.errors import C2NError
 
 # (module under pipelines.commands, attribute holding the click command)
 _COMMANDS: tuple[tuple[str, str], ...] = (
+    ("render", "render"),
+    ("demo", "demo"),
+    ("keypoints", "keypoints"),
+    ("models", "models"),
+    ("effort", "effort"),
+    ("score", "score"),
+    ("fidelity", "fidelity_study"),
+    ("capture", "capture"),
 )
 
 

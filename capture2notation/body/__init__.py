@@ -2,6 +2,7 @@
 
 from .frames import body_frame, segment_vectors
 from .kinematics import euler_to_matrix, forward_kinematics, global_rotations, matrix_to_euler
+from .landmarks import landmarks_from_joints, landmarks_from_pose  # noqa: F401
 from .skeleton import (
     BLAZEPOSE_LANDMARKS,
     BLAZEPOSE_TO_JOINT,

@@ -174,9 +174,10 @@ JOINT_TO_BLAZEPOSE: MappingProxyType = MappingProxyType(
 LIMITS_DEG: MappingProxyType = MappingProxyType(
     {
         "pelvis": ((-180, 180), (-180, 180), (-180, 180)),
-        "waist": ((-30, 60), (-35, 35), (-40, 40)),
-        "chest": ((-20, 30), (-20, 20), (-30, 30)),
-        "neck": ((-60, 70), (-45, 45), (-80, 80)),
+        # For upright segments rx < 0 bends forward (flexion), rx > 0 back.
+        "waist": ((-60, 30), (-35, 35), (-40, 40)),
+        "chest": ((-30, 20), (-20, 20), (-30, 30)),
+        "neck": ((-70, 60), (-45, 45), (-80, 80)),
         "head": ((0, 0), (0, 0), (0, 0)),
         # Shoulder flexion beyond 180 and a full circle of twist let the arm
         # pass through place high/low without a flip (Wolofsky ch. IV).
@@ -184,9 +185,11 @@ LIMITS_DEG: MappingProxyType = MappingProxyType(
         "right_elbow": ((0, 155), (0, 0), (0, 0)),
         "right_wrist": ((-70, 80), (-30, 30), (0, 0)),
         "right_hand_tip": ((0, 0), (0, 0), (0, 0)),
-        "right_hip": ((-45, 135), (-60, 45), (-60, 60)),
+        # A dancer's hip: the leg reaches side middle (à la seconde, Figure 7's
+        # phrase) and back middle (arabesque).
+        "right_hip": ((-90, 135), (-95, 45), (-60, 60)),
         "right_knee": ((-155, 0), (0, 0), (0, 0)),
-        "right_ankle": ((-50, 30), (-25, 25), (0, 0)),
+        "right_ankle": ((-50, 40), (-25, 25), (0, 0)),  # dorsiflexion 40: a deep plie
         "right_toe": ((0, 0), (0, 0), (0, 0)),
     }
 )

@@ -1,6 +1,41 @@
-"""Laban Effort: the logistic model, emotion presets, and its estimation."""
+"""Laban Effort: the logistic model, emotion presets, and its estimation.
 
+``estimate_effort(joints, confidence, fps, score, rng)`` → :class:`EffortResult`
+(per movement, pooled per part and phrase, emotion probabilities);
+``write_effort(result, outdir)`` writes ``effort.json`` and the plots.
+"""
+
+from .curves import ProgressCurve, progress_curve
+from .emotion import emotion_probabilities, same_or_different
+from .estimate import EffortResult, MovementEffort, estimate_effort, movement_windows
+from .fit import fit_logistic, fit_space
 from .model import TIME_RANGE, WEIGHT_RANGE, progress, progress_speed, space_radius
+from .pooled import PooledEffort, pooled_posterior
+from .posterior import Posterior, sample_posterior
 from .presets import PRESETS, Preset
+from .report import write_effort
 
-__all__ = ["PRESETS", "Preset", "TIME_RANGE", "WEIGHT_RANGE", "progress", "progress_speed", "space_radius"]
+__all__ = [
+    "PRESETS",
+    "Preset",
+    "TIME_RANGE",
+    "WEIGHT_RANGE",
+    "progress",
+    "progress_speed",
+    "space_radius",
+    "EffortResult",
+    "MovementEffort",
+    "PooledEffort",
+    "Posterior",
+    "ProgressCurve",
+    "emotion_probabilities",
+    "estimate_effort",
+    "fit_logistic",
+    "fit_space",
+    "movement_windows",
+    "pooled_posterior",
+    "progress_curve",
+    "same_or_different",
+    "sample_posterior",
+    "write_effort",
+]

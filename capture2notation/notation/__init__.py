@@ -5,6 +5,9 @@ registered score format (see :mod:`capture2notation.notation.formats`).
 """
 
 from .directions import bend_degree, canonical_vector, classify
+from .formats import read, register_format, write
+from .formats.json_format import score_from_dict, score_to_dict
+from .formats.laban_editor import write_laban_editor
 from .model import (
     DIRECTIONS,
     EMOTIONS,
@@ -18,6 +21,7 @@ from .model import (
     Score,
     Symbol,
 )
+from .staff import render_staff
 
 __all__ = [
     "DIRECTIONS",
@@ -34,4 +38,11 @@ __all__ = [
     "bend_degree",
     "canonical_vector",
     "classify",
+    "read",
+    "register_format",
+    "render_staff",
+    "score_from_dict",
+    "score_to_dict",
+    "write",
+    "write_laban_editor",
 ]

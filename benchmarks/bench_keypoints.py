@@ -1,0 +1,139 @@
+"""Keypoint stage benchmark: end-to-end speed and accuracy against MediaPipe.
+
+Run: ``python benchmarks/bench_keypoints.py [--frames N] [--threads T]``
+
+Prints
+* end-to-end frames per second (decode + localise + infer + filter) of
+  :func:`capture2notation.keypoints.extract` on mannequin renders written to
+  mp4 at 640×480 and 1280×720, with the share of each step;
+* the landmark model alone (ms per call, 1 session, ``threads`` intra-op);
+* accuracy on MediaPipe's fixtures (``pose.jpg``, ``pose_squats.mp4``) when
+  ``../shared/fixtures`` is present: the error distribution per coordinate.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from capture2notation.io.video import VideoWriter, iter_frames  # noqa: E402
+from capture2notation.keypoints import extract  # noqa: E402
+from capture2notation.keypoints.blazepose import BlazePose, crop_to_tensor  # noqa: E402
+
+FIXTURES = Path(os.environ.get("C2N_FIXTURES", ROOT.parent / "shared" / "fixtures"))
+
+
+def _demo_pose(n_frames: int, fps: float):
+    """A deterministic arm-and-leg movement for the virtual dancer."""
+    from capture2notation.body import JOINTS, Body
+    from capture2notation.body.skeleton import joint_index
+    from synthetic.render.scene import Pose
+
+    a = np.zeros((n_frames, len(JOINTS), 3))
+    s = 0.5 - 0.5 * np.cos(np.linspace(0, 2 * np.pi, n_frames))
+    a[:, joint_index("right_shoulder"), 1] = -1.3 * s
+    a[:, joint_index("left_shoulder"), 0] = 1.1 * s
+    a[:, joint_index("right_elbow"), 0] = 1.2 * s
+    a[:, joint_index("right_hip"), 0] = 0.5 * s
+    a[:, joint_index("right_knee"), 0] = -0.8 * s
+    root = np.zeros((n_frames, 3))
+    root[:, 2] = Body().rest[0, 2]
+    return Pose(a, root, Body(), fps)
+
+
+def _render(path: Path, size, n_frames: int) -> None:
+    from synthetic.render.camera import Camera
+    from synthetic.render.job import render_frames
+
+    pose = _demo_pose(n_frames, 25.0)
+    cam = Camera.for_view("45", size, pose.body.height)
+    with VideoWriter(path, pose.fps, size) as w:
+        for frame in render_frames(pose, cam, "mannequin"):
+            w.write(frame)
+
+
+def bench_end_to_end(bp: BlazePose, size, n_frames: int, tmp: Path) -> None:
+    video = tmp / f"bench_{size[0]}x{size[1]}.mp4"
+    _render(video, size, n_frames)
+    t0 = time.perf_counter()
+    n_decoded = sum(1 for _ in iter_frames(video))
+    t_decode = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    track = extract(video, estimator=bp)
+    t_all = time.perf_counter() - t0
+    frames = [f.image for f in iter_frames(video, stop=20)]
+    t0 = time.perf_counter()
+    for f in frames:
+        crop_to_tensor(f, np.array([size[0] / 2, size[1] / 2, size[1], size[1], 0.2]))
+    t_crop = (time.perf_counter() - t0) / len(frames)
+    print(
+        f"end-to-end {size[0]}x{size[1]}: {len(track) / t_all:6.1f} fps "
+        f"({1000 * t_all / len(track):.1f} ms/frame over {len(track)} frames; "
+        f"decode {1000 * t_decode / n_decoded:.1f} ms, crop+convert {1000 * t_crop:.2f} ms, "
+        f"person found in {np.mean(track.presence > 0):.0%})"
+    )
+
+
+def bench_model(bp: BlazePose, n: int = 50) -> None:
+    x = np.random.default_rng(0).random((1, 3, 256, 256), dtype=np.float32)
+    name = bp.session.get_inputs()[0].name
+    for _ in range(5):
+        bp.session.run(None, {name: x})
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        bp.session.run(None, {name: x})
+        times.append(time.perf_counter() - t0)
+    t = 1000 * np.array(times)
+    print(f"model alone: median {np.median(t):.1f} ms/call (p10 {np.percentile(t, 10):.1f}, p90 {np.percentile(t, 90):.1f})")
+
+
+def bench_fixtures(bp: BlazePose) -> None:
+    import cv2
+
+    mp = FIXTURES / "mediapipe"
+    if not (mp / "pose.jpg").exists():
+        print(f"fixtures not found under {FIXTURES}; skipping accuracy")
+        return
+    exp = json.loads((mp / "pose_expected.json").read_text())
+    est = bp.estimate_image(cv2.imread(str(mp / "pose.jpg")))
+    err = np.abs(est.xy[:, :2] - np.array(exp["pixel_xy"]))
+    werr = np.abs(est.world - np.array(exp["world_xyz_m"]))
+    print(f"pose.jpg: max {err.max():.1f} px (tolerance 15), median {np.median(err):.1f} px; world max {werr.max():.3f} m (tolerance 0.2)")
+    ref = np.array(json.loads((mp / "pose_squats.full.json").read_text()))
+    for smooth in (True, False):
+        track = extract(mp / "pose_squats.mp4", estimator=bp, smooth=smooth)
+        e = np.abs(track.xy[:, :, :2] - ref[:, :, :2]).ravel()
+        q = np.percentile(e, [50, 90, 95, 99, 100])
+        print(
+            f"pose_squats.mp4 ({'smoothed' if smooth else 'raw'}): {np.mean(e <= 31):.1%} of {e.size} coordinates "
+            f"within 31 px; percentiles 50/90/95/99/max = {' / '.join(f'{v:.1f}' for v in q)} px"
+        )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--frames", type=int, default=150, help="frames per rendered benchmark video")
+    ap.add_argument("--threads", type=int, default=2, help="onnxruntime intra-op threads")
+    args = ap.parse_args()
+    bp = BlazePose(threads=args.threads)
+    print(f"onnxruntime threads: {args.threads}; cpu count: {os.cpu_count()}")
+    bench_model(bp)
+    with tempfile.TemporaryDirectory(prefix="c2n-bench-") as tmp:
+        for size in ((640, 480), (1280, 720)):
+            bench_end_to_end(bp, size, args.frames, Path(tmp))
+    bench_fixtures(bp)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,262 @@
+"""Effort of a captured phrase: per movement, pooled, and the emotion.
+
+:func:`estimate_effort` is the library entry point used by ``c2n capture``
+and ``c2n effort``; :func:`write_effort` (in :mod:`.report`) writes
+``effort.json`` and the plots.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..body import JOINTS
+from ..errors import EffortError
+from ..notation.model import PART_SEGMENTS, Score
+from .curves import ProgressCurve, progress_curve
+from .emotion import emotion_probabilities, features
+from .fit import SpaceEstimate, fit_space
+from .pooled import PooledEffort, pool_curves
+from .posterior import Posterior, sample_posterior
+
+__all__ = ["EffortResult", "MovementEffort", "estimate_effort", "movement_windows"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class MovementEffort:
+    """Effort of one movement (one gesture symbol).
+
+    Attributes
+    ----------
+    part : str
+    start, duration : float
+        Beats, as in the score.
+    curve : ProgressCurve
+        Observed progress (window in seconds inside).
+    posterior : Posterior
+        (b, x0, ln σ) samples and diagnostics.
+    space : SpaceEstimate
+    """
+
+    part: str
+    start: float
+    duration: float
+    curve: ProgressCurve
+    posterior: Posterior
+    space: SpaceEstimate
+
+
+@dataclass(frozen=True)
+class EffortResult:
+    """Everything ``effort.json`` reports.
+
+    Attributes
+    ----------
+    movements : tuple of MovementEffort
+    pooled : PooledEffort or None
+        Whole phrase (None when no movement could be measured).
+    parts : dict of str to PooledEffort
+        Pooled per body part (parts with at least two movements).
+    tempo : float
+        Beats per minute, from the symbols' timing (the score's tempo).
+    emotion : dict or None
+        ``{happy, sad, angry, afraid: p}``.
+    skipped : tuple of dict
+        Movements not measured, with the reason.
+    """
+
+    movements: tuple
+    pooled: PooledEffort | None
+    parts: dict
+    tempo: float
+    emotion: dict | None
+    skipped: tuple = field(default_factory=tuple)
+
+    def to_dict(self) -> dict:
+        """The JSON-ready content of ``effort.json``."""
+        pooled = None
+        if self.pooled is not None:
+            pooled = _pooled_dict(self.pooled)
+            pooled["tempo"] = self.tempo
+            pooled["parts"] = {k: _pooled_dict(v) for k, v in self.parts.items()}
+        return {
+            "movements": [_movement_dict(m) for m in self.movements],
+            "pooled": pooled,
+            "emotion": self.emotion,
+            "skipped": list(self.skipped),
+        }
+
+
+def _effort_fields(post: Posterior, space: SpaceEstimate) -> dict:
+    return {
+        "time": post.summary(0),
+        "weight": post.summary(1),
+        "space": {"median": space.median, "ci90": list(space.ci90)},
+        "tau": float(np.max(post.tau)),
+        "acceptance": post.acceptance,
+        "converged": post.converged,
+    }
+
+
+def _movement_dict(m: MovementEffort) -> dict:
+    return {"part": m.part, "start": m.start, "duration": m.duration, **_effort_fields(m.posterior, m.space)}
+
+
+def _pooled_dict(p: PooledEffort) -> dict:
+    return {"n_movements": p.n_movements, **_effort_fields(p.posterior, p.space)}
+
+
+def movement_windows(score: Score, times: np.ndarray) -> list:
+    """Gesture symbols with their windows in seconds.
+
+    Returns
+    -------
+    list of (Symbol, t_start, t_end)
+        Only parts with a moving extremity (supports are not Effort-bearing).
+    """
+    out = []
+    for sym in score.symbols:
+        if sym.part in PART_SEGMENTS:
+            out.append((sym, score.seconds(sym.start), score.seconds(sym.end)))
+    return out
+
+
+def _sample_job(args):
+    """Worker: one posterior (top-level so process pools can pickle it)."""
+    tau, s, w, groups, seed, kw = args
+    return sample_posterior(tau, s, w, rng=seed, groups=groups, **kw)
+
+
+def estimate_effort(
+    joints,
+    confidence,
+    fps: float,
+    score: Score,
+    rng: np.random.Generator | int,
+    times=None,
+    joint_names=JOINTS,
+    workers: int = 1,
+    sampler_kw: dict | None = None,
+    per_movement: bool = True,
+    snap: bool = True,
+) -> EffortResult:
+    """Estimate Laban Effort per movement, pooled per part and phrase, and the emotion.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joint positions, metres (NaN where missing).
+    confidence : (T, J) ndarray or None
+        Per-frame confidence in [0, 1]; None means all ones.
+    fps : float
+        Frame rate, Hz (used for `times` when not given).
+    score : Score
+        The movements (symbols, beats) and tempo.
+    rng : numpy.random.Generator or int
+        Seeds every posterior; results do not depend on `workers`.
+    times : (T,) ndarray, optional
+        Frame times in seconds, beat 0 at t = 0 (default ``arange(T) / fps``).
+    joint_names : sequence of str
+        Names of the J joints.
+    workers : int
+        Processes for the posteriors (1 = in this process).
+    sampler_kw : dict, optional
+        Passed to :func:`.posterior.sample_posterior`.
+    per_movement : bool
+        Sample each movement's posterior (False: pooled estimates only, for
+        studies that need the phrase's Effort alone).
+    snap : bool
+        Snap movement windows to frames (see :func:`.curves.progress_curve`).
+
+    Returns
+    -------
+    EffortResult
+    """
+    if rng is None:
+        raise EffortError("estimate_effort needs an explicit rng (numpy Generator or seed)")
+    rng = np.random.default_rng(rng)
+    joints = np.asarray(joints, dtype=float)
+    if joints.ndim != 3 or joints.shape[2] != 3:
+        raise EffortError(f"joints must be (T, J, 3), got shape {joints.shape}")
+    if not (np.isfinite(fps) and fps > 0):
+        raise EffortError(f"fps must be > 0, got {fps}")
+    if times is None:
+        times = np.arange(joints.shape[0]) / float(fps)
+    times = np.asarray(times, dtype=float)
+    kw = dict(sampler_kw or {})
+
+    curves, syms, skipped = [], [], []
+    for sym, t0, t1 in movement_windows(score, times):
+        where = {"part": sym.part, "start": float(sym.start), "duration": float(sym.duration)}
+        if t0 < times[0] or t1 > times[-1] + 0.5 / fps:
+            skipped.append({**where, "reason": f"window {t0:.3f}-{t1:.3f} s outside the capture"})
+            continue
+        try:
+            c = progress_curve(joints, confidence, times, sym.part, t0, t1, joint_names, snap=snap)
+        except EffortError as exc:
+            skipped.append({**where, "reason": str(exc)})
+            continue
+        if c is None:
+            skipped.append({**where, "reason": "part held (turns less than 5 degrees)"})
+            continue
+        curves.append(c)
+        syms.append(sym)
+    for sk in skipped:
+        log.info("effort: skipped %s at beat %s: %s", sk["part"], sk["start"], sk["reason"])
+
+    by_part: dict[str, list] = {}
+    for c in curves:
+        by_part.setdefault(c.part, []).append(c)
+    groups = [(p, cs) for p, cs in by_part.items() if len(cs) >= 2]
+    if curves:
+        groups.append(("phrase", curves))
+
+    jobs = [(c.tau, c.s, c.weight, None) for c in curves] if per_movement else []
+    n_mov = len(jobs)
+    jobs += [(t, s, w, g) for t, s, w, _, g in (pool_curves(cs) for _, cs in groups)]
+    seeds = rng.integers(0, 2**63 - 1, size=len(jobs))
+    args = [(*job, int(seed), kw) for job, seed in zip(jobs, seeds)]
+    if workers > 1 and len(args) > 1:
+        with concurrent.futures.ProcessPoolExecutor(max_workers=workers) as ex:
+            posts = list(ex.map(_sample_job, args))
+    else:
+        posts = [_sample_job(a) for a in args]
+
+    movements = tuple(
+        MovementEffort(
+            part=sym.part,
+            start=float(sym.start),
+            duration=float(sym.duration),
+            curve=c,
+            posterior=post,
+            space=fit_space(c.tau, c.radial, c.weight),
+        )
+        for sym, c, post in zip(syms, curves, posts[:n_mov])
+    )
+    pooled_all = {}
+    for (label, cs), post in zip(groups, posts[n_mov:]):
+        tau, _, w, radial, _ = pool_curves(cs)
+        pooled_all[label] = PooledEffort(label, len(cs), post, fit_space(tau, radial, w))
+    phrase = pooled_all.pop("phrase", None)
+    tempo = float(score.tempo)
+    emotion = None
+    if phrase is not None:
+        emotion = emotion_probabilities(*_emotion_input(phrase, tempo))
+    return EffortResult(
+        movements=movements, pooled=phrase, parts=pooled_all, tempo=tempo, emotion=emotion, skipped=tuple(skipped)
+    )
+
+
+def _emotion_input(pooled: PooledEffort, tempo: float):
+    """Features and their posterior standard deviations for :func:`emotion_probabilities`."""
+    smp = pooled.posterior.samples
+    x = features(float(np.median(smp[:, 0])), float(np.median(smp[:, 1])), pooled.space.median, tempo)
+    lo, hi = pooled.space.ci90
+    # 90 % interval of a Gaussian is ±1.645 sd
+    sd = np.array([np.std(smp[:, 0]), np.std(smp[:, 1]), (hi - lo) / 3.29, 0.0])
+    return x, sd

@@ -1,0 +1,230 @@
+"""emcee posterior of (b, x0, ln σ) for one movement or a pooled set.
+
+Likelihood: ``s_i = progress(τ_i; b, x0) + ε_i``, ``ε_i ~ N(0, σ² / w_i)``
+with ``w_i`` the frame's confidence.  Priors: uniform on the working ranges
+``TIME_RANGE`` × ``WEIGHT_RANGE`` and uniform on ln σ in :data:`LOG_SIGMA_RANGE`
+(scale-free noise prior).  The log-probability is vectorised over walkers.
+
+Convergence follows emcee's documentation (Autocorrelation analysis &
+convergence): the chain is extended in blocks until it is longer than
+:data:`N_TAU` integrated autocorrelation times and the τ estimate moved by
+less than ``tau_rtol`` (5 %; the tutorial's example uses 1 %); burn-in is 2·max τ and thinning τ_min / 2.  A run that hits
+``max_steps`` first is returned with ``converged = False``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import emcee
+import numpy as np
+
+from ..errors import EffortError
+from .fit import fit_logistic
+from .model import TIME_RANGE, WEIGHT_RANGE
+
+__all__ = ["LOG_SIGMA_RANGE", "N_TAU", "Posterior", "log_probability", "sample_posterior"]
+
+log = logging.getLogger(__name__)
+
+#: Uniform prior bounds of ln σ (σ from 1e-4 to 0.5 in units of progress).
+LOG_SIGMA_RANGE = (np.log(1e-4), np.log(0.5))
+#: Chain length required, in autocorrelation times (emcee docs: ≥ 50 τ).
+N_TAU = 50
+
+
+@dataclass(frozen=True)
+class Posterior:
+    """Thinned posterior samples and the sampler's diagnostics.
+
+    Attributes
+    ----------
+    samples : (M, 3) ndarray
+        Columns b, x0, ln σ after burn-in and thinning.
+    tau : (3,) ndarray
+        Integrated autocorrelation time per parameter, steps.
+    acceptance : float
+        Mean acceptance fraction over walkers.
+    converged : bool
+        Chain longer than ``N_TAU``·max τ with a stable τ estimate.
+    steps : int
+        Steps run per walker.
+    start : (3,) ndarray
+        Least-squares start point (b, x0, ln σ).
+    """
+
+    samples: np.ndarray
+    tau: np.ndarray
+    acceptance: float
+    converged: bool
+    steps: int
+    start: np.ndarray
+
+    def summary(self, column: int) -> dict:
+        """``{"median": m, "ci90": [lo, hi]}`` of one parameter column."""
+        lo, med, hi = np.percentile(self.samples[:, column], [5, 50, 95])
+        return {"median": float(med), "ci90": [float(lo), float(hi)]}
+
+
+def log_probability(theta, tau, s, weight, onehot=None):
+    """Vectorised log-posterior (up to a constant).
+
+    Parameters
+    ----------
+    theta : (W, 3) ndarray
+        Walkers' (b, x0, ln σ).
+    tau, s, weight : (N,) ndarray
+        Data as in :func:`sample_posterior`.
+    onehot : (N, G) ndarray, optional
+        Movement membership of each sample.  When given, each movement's
+        observed progress is ``k_g · s(τ)`` with its own end scale ``k_g``
+        (flat prior), marginalised analytically: the progress is normalised
+        by the movement's noisy end point, which otherwise biases every
+        sample of the movement alike.  None: ``k = 1`` exactly.
+
+    Returns
+    -------
+    (W,) ndarray
+        −inf outside the prior box.
+    """
+    theta = np.atleast_2d(theta)
+    b, x0, lns = theta[:, 0], theta[:, 1], theta[:, 2]
+    inside = (
+        (b > TIME_RANGE[0]) & (b < TIME_RANGE[1])
+        & (x0 > WEIGHT_RANGE[0]) & (x0 < WEIGHT_RANGE[1])
+        & (lns > LOG_SIGMA_RANGE[0]) & (lns < LOG_SIGMA_RANGE[1])
+    )
+    out = np.full(theta.shape[0], -np.inf)
+    if not inside.any():
+        return out
+    bi, xi, li = b[inside, None], x0[inside, None], lns[inside]
+    # progress() inlined without its argument checks (the prior box already
+    # guarantees b < 0, 0 < x0 < 1): this is the sampler's hot path
+    lnx = np.log(xi)
+    model = (1.0 + np.exp(-bi * lnx)) / (1.0 + np.exp(bi * (np.log(tau)[None, :] - lnx)))  # (W', N)
+    if onehot is None:
+        chi2 = np.sum(weight * (s - model) ** 2, axis=1)
+        out[inside] = -0.5 * chi2 * np.exp(-2.0 * li) - tau.size * li
+        return out
+    # Gaussian integral over each k_g: chi2 at the best k_g plus a log-det term
+    ws = weight * s
+    if onehot.shape[1] == 1:  # one movement: plain sums are faster than the product
+        ss = np.sum(ws * s)
+        sm = np.sum(ws * model, axis=1, keepdims=True)
+        mm = np.sum(weight * model * model, axis=1, keepdims=True)
+    else:
+        ss = (ws * s) @ onehot  # (G,)
+        sm = (ws * model) @ onehot  # (W', G)
+        mm = (weight * model * model) @ onehot  # (W', G)
+    chi2 = np.sum(ss - sm * sm / mm, axis=1)
+    dof = tau.size - onehot.shape[1]
+    out[inside] = -0.5 * chi2 * np.exp(-2.0 * li) - dof * li - 0.5 * np.sum(np.log(mm), axis=1)
+    return out
+
+
+def sample_posterior(
+    tau,
+    s,
+    weight=None,
+    rng: np.random.Generator | int | None = None,
+    groups=None,
+    free_scale: bool = True,
+    nwalkers: int = 24,
+    block: int = 100,
+    max_steps: int = 6000,
+    tau_rtol: float = 0.05,
+) -> Posterior:
+    """Sample the posterior of (b, x0, ln σ) with emcee.
+
+    Parameters
+    ----------
+    tau, s : (N,) array_like
+        Normalised time in (0, 1) and progress of one movement, or of several
+        movements concatenated (pooled estimate: one shared (b, x0, σ)).
+    weight : (N,) array_like, optional
+        Per-sample confidence in (0, 1].
+    rng : numpy.random.Generator or int
+        Source of every random draw (walker ball and emcee's moves); required
+        so runs are reproducible.
+    groups : (N,) array_like of int, optional
+        Movement index of each sample when several are pooled (default: one
+        movement).
+    free_scale : bool
+        Give each movement a free end scale, marginalised analytically (see
+        :func:`log_probability`); False pins s(1) = 1 to the observed end.
+    nwalkers : int
+        Ensemble size (≥ 2 × 3 dimensions).
+    block : int
+        Steps between convergence checks.
+    max_steps : int
+        Give up (``converged = False``) after this many steps.
+    tau_rtol : float
+        Largest relative change of the τ estimate between checks for the
+        chain to count as converged (emcee's tutorial uses 0.01; 0.05 is
+        within the estimator's own noise at 50 τ and halves the run time).
+
+    Returns
+    -------
+    Posterior
+    """
+    if rng is None:
+        raise EffortError("sample_posterior needs an explicit rng (numpy Generator or seed)")
+    rng = np.random.default_rng(rng)
+    tau = np.asarray(tau, dtype=float)
+    s = np.asarray(s, dtype=float)
+    w = np.ones_like(tau) if weight is None else np.asarray(weight, dtype=float)
+    fit = fit_logistic(tau, s, w)
+    lns0 = float(np.clip(np.log(max(fit.sigma, 1.5e-4)), LOG_SIGMA_RANGE[0] + 0.1, LOG_SIGMA_RANGE[1] - 0.1))
+    # start inside the box even when the LSQ optimum sits on a range edge
+    b0 = float(np.clip(fit.b, TIME_RANGE[0] + 0.02, TIME_RANGE[1] - 0.02))
+    x00 = float(np.clip(fit.x0, WEIGHT_RANGE[0] + 0.005, WEIGHT_RANGE[1] - 0.005))
+    start = np.array([b0, x00, lns0])
+    # a small ball: a tenth of the linearised posterior width, so that
+    # walkers need not first contract (noise-free renders give widths of 1e-5)
+    ball = np.array([min(0.01, 0.1 * fit.sd[0]), min(0.002, 0.1 * fit.sd[1]), 0.05])
+    p0 = start + ball * rng.standard_normal((nwalkers, 3))
+    p0[:, 0] = np.clip(p0[:, 0], TIME_RANGE[0] + 1e-3, TIME_RANGE[1] - 1e-3)
+    p0[:, 1] = np.clip(p0[:, 1], WEIGHT_RANGE[0] + 1e-4, WEIGHT_RANGE[1] - 1e-4)
+    p0[:, 2] = np.clip(p0[:, 2], LOG_SIGMA_RANGE[0] + 1e-3, LOG_SIGMA_RANGE[1] - 1e-3)
+
+    onehot = None
+    if free_scale:
+        g = np.zeros(tau.size, dtype=int) if groups is None else np.asarray(groups)
+        if g.shape != tau.shape:
+            raise EffortError(f"groups must label each of the {tau.size} samples, got shape {g.shape}")
+        onehot = (g[:, None] == np.unique(g)[None, :]).astype(float)
+    sampler = emcee.EnsembleSampler(
+        nwalkers, 3, log_probability, args=(tau, s, w, onehot), vectorize=True,
+        moves=emcee.moves.DEMove(),
+    )
+    sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
+    state = p0
+    old_tau = np.inf
+    converged = False
+    steps = 0
+    while steps < max_steps:
+        state = sampler.run_mcmc(state, block, progress=False)
+        steps += block
+        act = sampler.get_autocorr_time(tol=0)
+        if np.all(np.isfinite(act)) and steps >= N_TAU * act.max() and np.all(np.abs(old_tau - act) / act < tau_rtol):
+            converged = True
+            break
+        old_tau = act
+    act = sampler.get_autocorr_time(tol=0)
+    if not converged:
+        log.info("emcee did not converge in %d steps (tau = %s)", steps, np.round(act, 1))
+    finite = np.isfinite(act) & (act > 0)
+    tmax = float(act[finite].max()) if finite.any() else float(steps) / N_TAU
+    tmin = float(act[finite].min()) if finite.any() else 1.0
+    burn = min(int(2 * tmax), steps // 2)
+    thin = max(1, int(0.5 * tmin))
+    samples = sampler.get_chain(discard=burn, thin=thin, flat=True)
+    return Posterior(
+        samples=samples,
+        tau=np.asarray(act, dtype=float),
+        acceptance=float(np.mean(sampler.acceptance_fraction)),
+        converged=converged,
+        steps=steps,
+        start=start,
+    )

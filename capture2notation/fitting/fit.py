@@ -1,0 +1,396 @@
+"""Fit the body model to 2D keypoints (BlazePose landmarks, plus world landmarks).
+
+Data terms (see :mod:`capture2notation.fitting.solver` for the solver):
+
+* reprojection: ``c_i · ρ(‖π(p_i(θ_t)) − x_i‖ · Z_t / (f σ_2d))`` for each
+  image landmark with confidence ``c_i`` (pixels turned into metres at the
+  performer's depth ``Z_t``, so the weights do not depend on image size);
+* world prior: the directions of segments measured by the keypoint model's
+  world landmarks (camera-aligned axes), ``‖R d/|d| − u‖ / σ_dir`` — this is
+  what resolves the depth ambiguity of a single view; the same landmarks give
+  the per-clip segment lengths.
+
+Missing or low-confidence landmarks carry zero or small weight and lower the
+output confidence of the joints they measure; frames with too few landmarks
+are returned as NaN with zero confidence rather than invented.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..body import JOINTS, Body, joint_index
+from ..errors import FittingError
+from .camera import DEFAULT_HFOV_DEG, Camera
+from .lengths import estimate_offsets
+from .model import PoseModel
+from .result import FitResult
+from .solver import FitOptions, Terms, check_fps, fill, fill2, pelvis_axis, rewarm, solve, to_result
+
+__all__ = ["fit_keypoints", "fit_track", "refine_focal", "TARGETS_2D"]
+
+_J = len(JOINTS)
+
+#: Image targets: model point -> BlazePose landmarks averaged to measure it,
+#: and the relative weight of its reprojection term (head and heel points of
+#: the model are approximate, so they pull less).
+TARGETS_2D: tuple[tuple[str, tuple[int, ...], float], ...] = (
+    ("pelvis", (23, 24), 0.0),  # duplicate of the hips in 2D; used for directions
+    ("neck", (11, 12), 0.0),  # likewise of the shoulders
+    ("right_shoulder", (12,), 1.0),
+    ("right_elbow", (14,), 1.0),
+    ("right_wrist", (16,), 1.0),
+    ("right_hand_tip", (20,), 0.5),
+    ("left_shoulder", (11,), 1.0),
+    ("left_elbow", (13,), 1.0),
+    ("left_wrist", (15,), 1.0),
+    ("left_hand_tip", (19,), 0.5),
+    ("right_hip", (24,), 1.0),
+    ("right_knee", (26,), 1.0),
+    ("right_ankle", (28,), 1.0),
+    ("right_toe", (32,), 0.7),
+    ("left_hip", (23,), 1.0),
+    ("left_knee", (25,), 1.0),
+    ("left_ankle", (27,), 1.0),
+    ("left_toe", (31,), 0.7),
+    ("nose", (0,), 0.3),
+    ("left_ear", (7,), 0.3),
+    ("right_ear", (8,), 0.3),
+    ("right_heel", (30,), 0.5),
+    ("left_heel", (29,), 0.5),
+)
+
+#: Segments whose measured direction constrains depth (pairs of target names, weight).
+_DIRECTIONS: tuple[tuple[str, str, float], ...] = (
+    ("pelvis", "neck", 1.0),
+    ("left_hip", "right_hip", 1.0),
+    ("left_shoulder", "right_shoulder", 1.0),
+    ("right_shoulder", "right_elbow", 1.0),
+    ("right_elbow", "right_wrist", 1.0),
+    ("right_wrist", "right_hand_tip", 0.3),
+    ("left_shoulder", "left_elbow", 1.0),
+    ("left_elbow", "left_wrist", 1.0),
+    ("left_wrist", "left_hand_tip", 0.3),
+    ("right_hip", "right_knee", 1.0),
+    ("right_knee", "right_ankle", 1.0),
+    ("right_ankle", "right_toe", 0.5),
+    ("left_hip", "left_knee", 1.0),
+    ("left_knee", "left_ankle", 1.0),
+    ("left_ankle", "left_toe", 0.5),
+    ("neck", "nose", 0.3),
+    ("left_ear", "right_ear", 0.3),
+)
+
+#: Joints measured by other joints' targets (for the output confidence).
+_DERIVED_CONF = {
+    "waist": ("pelvis", "neck"),
+    "chest": ("pelvis", "neck"),
+    "head": ("nose", "left_ear", "right_ear"),
+}
+
+
+# --------------------------------------------------------------------------- 2D fitting
+
+
+def _targets_from_landmarks(xy, conf, world, opt):
+    """Average landmarks into model targets.
+
+    Returns names (N,), xy (T,N,2), conf (T,N), world (T,N,3) or None.
+    """
+    names = [t[0] for t in TARGETS_2D]
+    T = xy.shape[0]
+    N = len(names)
+    tx = np.full((T, N, 2), np.nan)
+    tc = np.zeros((T, N))
+    tw = None if world is None else np.full((T, N, 3), np.nan)
+    for i, (_, lms, _) in enumerate(TARGETS_2D):
+        lms = list(lms)
+        c = np.min(conf[:, lms], axis=1)
+        ok = (c >= opt.min_confidence) & np.all(np.isfinite(xy[:, lms]), axis=(1, 2))
+        tx[ok, i] = xy[ok][:, lms].mean(axis=1)
+        tc[:, i] = np.where(ok, c, 0.0)
+        if world is not None:
+            okw = ok & np.all(np.isfinite(world[:, lms]), axis=(1, 2))
+            tw[okw, i] = world[okw][:, lms].mean(axis=1)
+    return names, tx, tc, tw
+
+
+def _direction_terms(names, tc, tw):
+    """Unit directions of segments from target world positions; (B,2) name pairs, (T,B,3), (T,B)."""
+    pairs, dirs, w = [], [], []
+    for a, b, wt in _DIRECTIONS:
+        ia, ib = names.index(a), names.index(b)
+        d = tw[:, ib] - tw[:, ia]
+        ln = np.linalg.norm(d, axis=-1, keepdims=True)
+        ok = np.isfinite(ln[:, 0]) & (ln[:, 0] > 1e-6)
+        u = np.where(ok[:, None], d / np.where(ok[:, None], ln, 1.0), np.nan)
+        pairs.append((a, b))
+        dirs.append(u)
+        w.append(np.where(ok, wt * np.minimum(tc[:, ia], tc[:, ib]), 0.0))
+    return pairs, np.stack(dirs, 1), np.stack(w, 1)
+
+
+def _world_offsets(names, tc, tw, body):
+    """Per-clip offsets from world landmarks (MediaPipe's are metric)."""
+    pts = np.full((tc.shape[0], _J, 3), np.nan)
+    conf = np.zeros((tc.shape[0], _J))
+    for i, name in enumerate(names):
+        if name in JOINTS:
+            pts[:, joint_index(name)] = tw[:, i]
+            conf[:, joint_index(name)] = tc[:, i]
+    return estimate_offsets(pts, conf, body)
+
+
+def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw) -> np.ndarray:
+    """Root from the hip midpoint at a depth from the figure's scale; pelvis yaw facing as measured."""
+    T = tx.shape[0]
+    n = model.n_params
+    params = np.zeros((T, n))
+    pel_px = tx[:, names.index("pelvis")]
+    neck_px = tx[:, names.index("neck")]
+    rest = model.forward(np.zeros((1, n)))[0]
+    f = cam.focal
+    # Depth from lengths seen in the image: foreshortening only shortens, so
+    # use a low quantile of the per-segment estimates.
+    segs = [("pelvis", "neck"), ("right_hip", "right_knee"), ("left_hip", "left_knee"),
+            ("right_knee", "right_ankle"), ("left_knee", "left_ankle"),
+            ("right_shoulder", "right_elbow"), ("left_shoulder", "left_elbow")]
+    est = []
+    for a, b in segs:
+        L = np.linalg.norm(rest[model.index(b)] - rest[model.index(a)])
+        lpx = np.linalg.norm(tx[:, names.index(b)] - tx[:, names.index(a)], axis=-1)
+        est.append(np.where(lpx > 2.0, f * L / lpx, np.nan))
+    est = np.stack(est, 1)
+    depth = np.full(T, np.nan)
+    seen = np.any(np.isfinite(est), axis=1)
+    if seen.any():
+        depth[seen] = np.nanquantile(est[seen], 0.3, axis=1)
+    depth = fill(depth, fallback=float(np.linalg.norm(cam.centre)))
+    centre = np.where(np.isfinite(pel_px), pel_px, neck_px)
+    centre = fill2(centre, fallback=np.array(cam.K[:2, 2]))
+    root = cam.backproject(centre, depth)
+    params[:, :3] = root
+    # Yaw: the forward direction faces the camera unless the hips say otherwise.
+    to_cam = cam.centre[None, :] - root
+    yaw = np.arctan2(-to_cam[:, 0], to_cam[:, 1])
+    ir, il = names.index("right_hip"), names.index("left_hip")
+    if tw is not None:
+        right_w = (tw[:, ir] - tw[:, il]) @ cam.R  # camera axes -> world
+        ok = np.all(np.isfinite(right_w), axis=1) & (np.hypot(right_w[:, 0], right_w[:, 1]) > 1e-6)
+        yaw = np.where(ok, np.arctan2(right_w[:, 1], right_w[:, 0]), yaw)
+    else:
+        seen = tx[:, ir] - tx[:, il]
+        right_model = np.stack([np.cos(yaw), np.sin(yaw), np.zeros(T)], 1)
+        expect = cam.project(root + 0.1 * right_model) - cam.project(root)
+        flip = np.sum(seen * expect, axis=1) < 0
+        yaw = np.where(flip, yaw + np.pi, yaw)
+    yaw = np.unwrap(fill(yaw, fallback=0.0))
+    params[:, 3 + pelvis_axis(model, 2)] = yaw
+    return params
+
+
+def _check_2d(xy, confidence, world):
+    xy = np.asarray(xy, float)
+    if xy.ndim != 3 or xy.shape[1] != 33 or xy.shape[2] < 2:
+        raise FittingError(f"keypoints must have shape (T, 33, 2), got {xy.shape}")
+    xy = xy[..., :2]
+    conf = np.asarray(confidence, float)
+    if conf.shape != xy.shape[:2]:
+        raise FittingError(f"confidence must have shape {xy.shape[:2]}, got {conf.shape}")
+    conf = np.where(np.isfinite(conf), np.clip(conf, 0.0, 1.0), 0.0)
+    if world is not None:
+        world = np.asarray(world, float)
+        if world.shape != xy.shape[:2] + (3,):
+            raise FittingError(f"world landmarks must have shape {xy.shape[:2] + (3,)}, got {world.shape}")
+    if xy.shape[0] == 0:
+        raise FittingError("no frames to fit (T = 0)")
+    return xy, conf, world
+
+
+def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, world=None,
+                  body: Body | None = None, times=None, image_size=None,
+                  options: FitOptions | None = None) -> FitResult:
+    """Fit 3D joint angles to a track of 2D BlazePose landmarks.
+
+    Parameters
+    ----------
+    xy : (T, 33, 2) ndarray
+        Landmark pixel coordinates; NaN where missing.
+    confidence : (T, 33) ndarray
+        Per-landmark confidence (visibility) in [0, 1].
+    fps : float
+        Frame rate, frames per second.
+    camera : Camera, optional
+        Known camera (e.g. from a truth sidecar).  Default:
+        :meth:`Camera.default` for `image_size` with the focal length refined
+        from the data, and the floor set from the lowest feet.
+    world : (T, 33, 3) ndarray, optional
+        World landmarks, metres, camera-aligned axes (hip-centred, +x image
+        right, +y down, +z away from the camera); give the segment directions
+        that resolve depth and the per-clip segment lengths.
+    body : Body, optional
+        Proportions when no world landmarks give lengths (default ``Body()``).
+    times : (T,) ndarray, optional
+        Seconds (default ``arange(T) / fps``).
+    image_size : (width, height), optional
+        Needed when `camera` is None.
+    options : FitOptions, optional
+
+    Returns
+    -------
+    FitResult
+    """
+    opt = options or FitOptions()
+    xy, conf, world = _check_2d(xy, confidence, world)
+    check_fps(fps)
+    body = body or Body()
+    set_floor = camera is None
+    if camera is None:
+        if image_size is None:
+            raise FittingError("fit_keypoints needs a camera or the image_size (width, height) for a default camera")
+        camera = refine_focal(xy, conf, fps, Camera.default(image_size), world=world, body=body, options=opt)
+    model, terms, (names, tx, tc, tw), use2 = _problem(xy, conf, world, body, camera, opt)
+    params0 = _initial_params(model, camera, names, tx, tc, tw)
+    params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
+    params, cost = rewarm(model, params, cost, terms, fps, opt)
+    usable = np.sum(tc[:, use2] >= opt.min_confidence, axis=1) >= opt.min_targets
+    # Per-target fit quality from the remaining reprojection error (sigma units).
+    pts = model.forward(params)
+    uv = camera.project(pts[:, terms.idx2])
+    depth = np.maximum(camera.to_camera(params[:, :3])[:, 2], 0.1)
+    err = np.linalg.norm(uv - tx[:, use2], axis=-1) * (depth / (camera.focal * opt.sigma_2d))[:, None]
+    quality = np.ones_like(tc)
+    quality[:, use2] = 1.0 / (1.0 + (np.nan_to_num(err, nan=np.inf) / 3.0) ** 2)
+    target_conf = tc * quality
+    result = to_result(model, params, fps, times, _joint_confidence(names, target_conf), usable)
+    return _floored(result, model) if set_floor else result
+
+
+def _joint_confidence(names, tconf) -> np.ndarray:
+    """(T, J) joint confidence from per-target confidence (T, N)."""
+    T = tconf.shape[0]
+    out = np.zeros((T, _J))
+    for j, name in enumerate(JOINTS):
+        if name in names:
+            out[:, j] = tconf[:, names.index(name)]
+        elif name in _DERIVED_CONF:
+            cols = [names.index(n) for n in _DERIVED_CONF[name]]
+            agg = np.max if name == "head" else np.min
+            out[:, j] = agg(tconf[:, cols], axis=1)
+    return out
+
+
+def _floored(res: FitResult, model: PoseModel) -> FitResult:
+    """Shift the clip so its lowest feet touch z = 0 (2nd percentile, robust to glitches)."""
+    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
+    low = np.nanmin(res.joints[:, feet, 2], axis=1) if np.any(np.isfinite(res.joints)) else np.array([np.nan])
+    if not np.any(np.isfinite(low)):
+        return res
+    rest = model.forward(np.zeros((1, model.n_params)))[0, :_J]
+    rest_low = rest[feet, 2].min() - rest[:, 2].min() + model.body.rest[:, 2].min()
+    dz = rest_low - np.nanpercentile(low, 2)
+    shift = np.array([0.0, 0.0, dz])
+    return res.replace(joints=res.joints + shift, root=res.root + shift)
+
+
+def refine_focal(xy, confidence, fps, camera: Camera, world=None, body=None,
+                 options: FitOptions | None = None, hfovs=(40.0, 50.0, 60.0, 70.0, 85.0),
+                 max_frames: int = 24) -> Camera:
+    """Choose the focal length that best explains the data.
+
+    Fits up to `max_frames` evenly spaced frames for each candidate horizontal
+    field of view and keeps the one with the lowest robust cost (a parabola
+    through the best three refines it).  With 2D landmarks only, focal length
+    and distance trade off and the default (``DEFAULT_HFOV_DEG``) is kept.
+
+    Returns
+    -------
+    Camera
+        `camera` with the refined focal length.
+    """
+    opt = options or FitOptions()
+    if world is None:
+        return camera
+    T = xy.shape[0]
+    sel = np.unique(np.linspace(0, T - 1, min(T, max_frames)).round().astype(int))
+    w = camera.image_size[0]
+    costs = []
+    quick = FitOptions(**{**opt.__dict__, "iterations": 10})
+    for h in hfovs:
+        cam = camera.with_focal(0.5 * w / np.tan(np.deg2rad(h) / 2))
+        res_cost = _quick_cost(xy[sel], confidence[sel], fps, cam, world[sel], body, quick)
+        costs.append(res_cost)
+    costs = np.asarray(costs)
+    if not np.all(np.isfinite(costs)):
+        return camera.with_focal(0.5 * w / np.tan(np.deg2rad(DEFAULT_HFOV_DEG) / 2))
+    i = int(np.argmin(costs))
+    h = hfovs[i]
+    if 0 < i < len(hfovs) - 1:
+        x, y = np.asarray(hfovs[i - 1 : i + 2]), costs[i - 1 : i + 2]
+        a, b, _ = np.polyfit(x, y, 2)
+        if a > 0:
+            h = float(np.clip(-b / (2 * a), x[0], x[2]))
+    return camera.with_focal(0.5 * w / np.tan(np.deg2rad(h) / 2))
+
+
+def _quick_cost(xy, conf, fps, cam, world, body, opt) -> float:
+    """Total robust cost of fitting a few frames with camera `cam`."""
+    model, terms, (names, tx, tc, tw), _ = _problem(xy, conf, world, body or Body(), cam, opt)
+    p0 = _initial_params(model, cam, names, tx, tc, tw)
+    # The frames are far apart in time: a tiny rate switches the temporal term off.
+    _, cost = solve(model, p0, terms, 1e-6, opt, opt.iterations)
+    return float(np.sum(cost))
+
+
+def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions):
+    """Model with the clip's segment lengths and the data terms of a 2D fit.
+
+    Returns
+    -------
+    model : PoseModel
+    terms : Terms
+    targets : (names, xy (T,N,2), conf (T,N), world (T,N,3) or None)
+    use2 : (N,) bool
+        Targets with a reprojection term.
+    """
+    names, tx, tc, tw = _targets_from_landmarks(xy, conf, world, opt)
+    offsets = _world_offsets(names, tc, tw, body) if tw is not None else body.offsets
+    model = PoseModel(body, offsets)
+    w_targets = np.array([t[2] for t in TARGETS_2D])
+    use2 = w_targets > 0
+    terms = Terms(camera=camera, idx2=np.array([model.index(nm) for nm in np.array(names)[use2]]),
+                  obs2=tx[:, use2], w2=tc[:, use2] * w_targets[use2])
+    if tw is not None:
+        pairs, dirs, wd = _direction_terms(names, tc, tw)
+        terms.pairs = np.array([[model.index(a), model.index(b)] for a, b in pairs])
+        terms.dirs, terms.wd = dirs, wd
+    return model, terms, (names, tx, tc, tw), use2
+
+
+def fit_track(track, camera: Camera | None = None, body: Body | None = None,
+              options: FitOptions | None = None) -> FitResult:
+    """Fit a :class:`~capture2notation.keypoints.KeypointTrack`.
+
+    Parameters
+    ----------
+    track : KeypointTrack
+        Uses ``xy (T, 33, ≥2)``, ``visibility (T, 33)``, ``presence (T,)``,
+        ``world (T, 33, 3)`` (optional), ``fps``, ``times``, ``image_size``.
+    camera : Camera, optional
+        Known camera; default a :meth:`Camera.default` refined from the data.
+    body, options : optional
+        Passed to :func:`fit_keypoints`.
+    """
+    xy = np.asarray(track.xy, float)
+    vis = np.asarray(track.visibility, float)
+    presence = getattr(track, "presence", None)
+    if presence is not None:
+        vis = vis * np.clip(np.nan_to_num(np.asarray(presence, float)), 0, 1)[:, None]
+    world = getattr(track, "world", None)
+    if world is not None:
+        world = np.asarray(world, float)
+        if not np.any(np.isfinite(world)):
+            world = None
+    return fit_keypoints(xy[..., :2], vis, float(track.fps), camera=camera, world=world, body=body,
+                         times=getattr(track, "times", None), image_size=tuple(np.asarray(track.image_size).tolist()),
+                         options=options)

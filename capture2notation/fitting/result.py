@@ -1,0 +1,72 @@
+"""The output of fitting: 3D joints, joint angles and confidences over time."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..body import JOINTS
+from ..errors import FittingError
+
+__all__ = ["FitResult"]
+
+
+@dataclass(frozen=True, eq=False)
+class FitResult:
+    """A fitted (or read) motion of the canonical skeleton.
+
+    Attributes
+    ----------
+    fps : float
+        Frames per second.
+    times : (T,) ndarray
+        Seconds.
+    joints : (T, J, 3) ndarray
+        World positions of :data:`~capture2notation.body.JOINTS`, metres, z
+        up, floor z = 0 where it can be inferred; NaN in frames that could not
+        be fitted.
+    angles : (T, J, 3) ndarray
+        Local Euler angles ``(rx, ry, rz)``, radians (ARCHITECTURE.md).
+    root : (T, 3) ndarray
+        Pelvis position, metres.
+    confidence : (T, J) ndarray
+        In [0, 1]; 0 where a joint is not measured.
+    offsets : (J, 3) ndarray or None
+        Per-clip offsets of each joint from its parent, metres:
+        ``forward_kinematics`` with these offsets reproduces `joints` exactly
+        (``Body(height)`` proportions reproduce them approximately).
+    """
+
+    fps: float
+    times: np.ndarray
+    joints: np.ndarray
+    angles: np.ndarray
+    root: np.ndarray
+    confidence: np.ndarray
+    offsets: np.ndarray | None = None
+
+    def __post_init__(self):
+        T = np.shape(self.times)[0] if np.ndim(self.times) == 1 else -1
+        J = len(JOINTS)
+        expect = {"joints": (T, J, 3), "angles": (T, J, 3), "root": (T, 3), "confidence": (T, J)}
+        for name, shape in expect.items():
+            if np.shape(getattr(self, name)) != shape:
+                raise FittingError(f"{type(self).__name__}.{name} must have shape {shape}, got {np.shape(getattr(self, name))}")
+        if not (np.isfinite(self.fps) and self.fps > 0):
+            raise FittingError(f"{type(self).__name__}.fps must be positive, got {self.fps!r}")
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames T."""
+        return int(self.times.shape[0])
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of the J joints (:data:`~capture2notation.body.JOINTS`)."""
+        return JOINTS
+
+    def replace(self, **changes):
+        """A copy with some fields replaced."""
+        return dataclasses.replace(self, **changes)

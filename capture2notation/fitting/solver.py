@@ -1,0 +1,278 @@
+"""Vectorised robust Levenberg–Marquardt shared by the 2D and 3D fits.
+
+The problem, per frame ``t`` with parameters ``θ_t = [root, free angles]``
+(:class:`~capture2notation.fitting.model.PoseModel`), is robust weighted least
+squares over the data terms of :class:`Terms` (reprojection, segment
+directions, 3D positions), a temporal smoothness term
+``(θ_t − (θ_{t−1} + θ_{t+1}) / 2) / σ_t``, a weak pull to the rest pose
+(twists a little firmer), and the joint limits as a box constraint
+(projection after every step).  Huber's loss is applied by iteratively
+reweighting.
+
+All frames are solved together: one batched ``(T, n, n)`` solve per
+iteration, each frame damping its own step and accepting it only when its
+cost falls.  The temporal term is updated Jacobi-style from the neighbours'
+current estimates, so each iteration is warm-started from the last and
+information flows between frames; afterwards frames much worse than their
+predecessor are solved again warm-started from the previous frame's pose.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..body import JOINTS
+from ..errors import FittingError
+from .camera import Camera
+from .model import PoseModel
+from .result import FitResult
+
+__all__ = ["FitOptions", "Terms", "solve", "rewarm", "to_result"]
+
+_J = len(JOINTS)
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """Weights and iteration counts of the fit.
+
+    Attributes
+    ----------
+    sigma_2d : float
+        Reprojection noise expressed at the performer's depth, metres.
+    sigma_dir : float
+        Noise of a world-landmark segment direction (unit-vector difference).
+    sigma_3d : float
+        Noise of a 3D joint position, metres.
+    sigma_smooth : float
+        Second-difference noise of an angle at 25 fps, radians (scaled by
+        ``25 / fps`` for other rates); root uses ``sigma_smooth`` metres.
+    sigma_rest, sigma_twist : float
+        Spread of the pull to the rest pose for swings and for twists, radians.
+    huber : float
+        Huber threshold in units of sigma.
+    iterations : int
+        Levenberg–Marquardt iterations over all frames.
+    min_targets : int
+        Frames with fewer usable targets are returned as NaN.
+    min_confidence : float
+        Landmarks below this confidence are ignored.
+    """
+
+    sigma_2d: float = 0.02
+    sigma_dir: float = 0.12
+    sigma_3d: float = 0.02
+    sigma_smooth: float = 0.08
+    sigma_rest: float = 1.5
+    sigma_twist: float = 0.5
+    huber: float = 2.0
+    iterations: int = 20
+    min_targets: int = 6
+    min_confidence: float = 0.1
+
+
+@dataclass
+class Terms:
+    """Observations of one fit, already mapped to model points."""
+
+    idx2: np.ndarray | None = None  # (N,) point index of image targets
+    obs2: np.ndarray | None = None  # (T, N, 2) pixels
+    w2: np.ndarray | None = None  # (T, N)
+    camera: Camera | None = None
+    pairs: np.ndarray | None = None  # (B, 2) point indices of measured directions
+    dirs: np.ndarray | None = None  # (T, B, 3) unit directions (camera axes, or world for 3D)
+    wd: np.ndarray | None = None  # (T, B)
+    idx3: np.ndarray | None = None  # (N3,) point index of 3D targets
+    obs3: np.ndarray | None = None  # (T, N3, 3)
+    w3: np.ndarray | None = None  # (T, N3)
+
+
+def _normal_equations(model: PoseModel, params, terms: Terms, opt: FitOptions, need_jac: bool):
+    """Per-frame cost, and (if asked) Gauss-Newton ``H = JᵀWJ`` and ``g = JᵀWr``."""
+    T, n = params.shape
+    if need_jac:
+        pts, jac = model.forward(params, jacobian=True)
+    else:
+        pts = model.forward(params)
+    cost = np.zeros(T)
+    k = opt.huber
+    rows_J, rows_r = [], []
+
+    def add(r, w, Jr):
+        # r (T, N, d) in sigma units, w (T, N), Jr (T, N, d, n); Huber by IRLS.
+        e = np.linalg.norm(r, axis=-1)
+        cost[:] += np.sum(w * np.where(e <= k, 0.5 * e**2, k * e - 0.5 * k**2), axis=1)
+        if need_jac:
+            sw = np.sqrt(w * np.where(e <= k, 1.0, k / np.maximum(e, 1e-12)))[..., None]
+            rows_r.append((sw * r).reshape(T, -1))
+            rows_J.append((sw[..., None] * Jr).reshape(T, -1, n))
+
+    if terms.idx2 is not None:
+        cam = terms.camera
+        p = pts[:, terms.idx2]
+        c = cam.to_camera(p)
+        z = np.maximum(c[..., 2], 1e-3)
+        f = np.array([cam.K[0, 0], cam.K[1, 1]])
+        uv = c[..., :2] / z[..., None] * f + cam.K[:2, 2]
+        depth = np.maximum(cam.to_camera(params[:, :3])[:, 2], 0.1)
+        s = depth / (cam.focal * opt.sigma_2d)  # (T,) pixels -> sigma units
+        obs = np.nan_to_num(terms.obs2)
+        r = (uv - obs) * s[:, None, None]
+        Jr = None
+        if need_jac:
+            # d(uv)/dp = f/z (R_row - c_row/z R_2), then chain with dp/dθ.
+            R = cam.R
+            dcam = R @ jac[:, terms.idx2]  # (T, N, 3, n)
+            duv = (dcam[:, :, :2] - (c[..., :2] / z[..., None])[..., None] * dcam[:, :, 2:3]) \
+                * (f[None, None, :, None] / z[..., None, None])
+            Jr = duv * s[:, None, None, None]
+        add(r, terms.w2, Jr)
+
+    if terms.pairs is not None:
+        a, b = terms.pairs[:, 0], terms.pairs[:, 1]
+        Rc = terms.camera.R if terms.camera is not None else np.eye(3)
+        d = (pts[:, b] - pts[:, a]) @ Rc.T
+        ln = np.maximum(np.linalg.norm(d, axis=-1, keepdims=True), 1e-9)
+        m = d / ln
+        r = (m - np.nan_to_num(terms.dirs)) / opt.sigma_dir
+        Jr = None
+        if need_jac:
+            dd = Rc @ (jac[:, b] - jac[:, a])
+            proj = (np.eye(3) - m[..., :, None] * m[..., None, :]) / (ln[..., None] * opt.sigma_dir)
+            Jr = proj @ dd
+        add(r, terms.wd, Jr)
+
+    if terms.idx3 is not None:
+        r = (pts[:, terms.idx3] - np.nan_to_num(terms.obs3)) / opt.sigma_3d
+        Jr = jac[:, terms.idx3] / opt.sigma_3d if need_jac else None
+        add(r, terms.w3, Jr)
+
+    if need_jac:
+        A = np.concatenate(rows_J, axis=1)  # (T, M, n) whitened Jacobian
+        b = np.concatenate(rows_r, axis=1)
+        At = A.transpose(0, 2, 1)
+        return cost, At @ A, (At @ b[..., None])[..., 0]
+    return cost
+
+
+def _temporal_ref(params: np.ndarray) -> np.ndarray:
+    """Mean of each frame's neighbours (a single neighbour at the ends)."""
+    if params.shape[0] == 1:
+        return params.copy()
+    ref = np.empty_like(params)
+    ref[1:-1] = 0.5 * (params[:-2] + params[2:])
+    ref[0], ref[-1] = params[1], params[-2]
+    return ref
+
+
+def _prior_precision(model: PoseModel, fps: float, opt: FitOptions, T: int):
+    """Diagonal precisions of the temporal and rest terms, ``(n,)`` each."""
+    n = model.n_params
+    # Per-frame changes shrink with the frame rate; linear (not quadratic)
+    # scaling keeps high-rate mocap from being over-smoothed.
+    scale = 25.0 / fps if fps > 0 else 1.0
+    smooth = np.full(n, 1.0 / (opt.sigma_smooth * scale) ** 2)
+    if T == 1:
+        smooth[:] = 0.0
+    rest = np.full(n, 1.0 / opt.sigma_rest**2)
+    rest[:3] = 0.0
+    twist = (model.dof_axis == 2) & (model.dof_joint != 0)
+    rest[3:][twist] = 1.0 / opt.sigma_twist**2
+    rest[3:][model.dof_joint == 0] = 0.0  # the pelvis orientation is free
+    return smooth, rest
+
+
+def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
+           iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """Vectorised Levenberg–Marquardt over all frames; returns (params, data cost per frame).
+
+    The first two thirds of the iterations use a hundredth of the temporal
+    weight, so frames converge on their own data first; Jacobi coupling with
+    full weight would otherwise spread information one frame per iteration.
+    """
+    T, n = params.shape
+    smooth_full, rest = _prior_precision(model, fps, opt, T)
+    mu = np.full(T, 1e-2)
+    lower, upper = model.lower, model.upper
+
+    def total(p, ref, data):
+        return data + 0.5 * np.sum(smooth * (p - ref) ** 2 + rest * p**2, axis=1)
+
+    for it in range(iterations):
+        smooth = smooth_full * (0.01 if it < (2 * iterations) // 3 else 1.0)
+        ref = _temporal_ref(params)
+        cost, H, g = _normal_equations(model, params, terms, opt, need_jac=True)
+        H += np.diag(smooth + rest)
+        g += smooth * (params - ref) + rest * params
+        diag = np.einsum("tii->ti", H)
+        A = H + (mu[:, None] * (diag + 1e-6))[:, :, None] * np.eye(n)
+        step = -np.linalg.solve(A, g[..., None])[..., 0]
+        cand = np.clip(params + step, lower, upper)
+        new = total(cand, ref, _normal_equations(model, cand, terms, opt, need_jac=False))
+        better = new < total(params, ref, cost)
+        params = np.where(better[:, None], cand, params)
+        mu = np.where(better, mu / 3.0, np.minimum(mu * 4.0, 1e6))
+    return params, _normal_equations(model, params, terms, opt, need_jac=False)
+
+
+def rewarm(model, params, cost, terms, fps, opt, ratio=3.0, iterations=8):
+    """Re-solve frames much worse than their predecessor, starting from its pose."""
+    flagged = np.nonzero(cost[1:] > ratio * np.maximum(cost[:-1], 1.0))[0] + 1
+    for t in flagged:  # only the few frames stuck in a poor local minimum
+        if cost[t] <= ratio * max(cost[t - 1], 1.0):
+            continue
+        p1, c1 = solve(model, params[t - 1 : t].copy(), _subset(terms, slice(t, t + 1)), fps, opt, iterations)
+        if c1[0] < cost[t]:
+            params[t], cost[t] = p1[0], c1[0]
+    return params, cost
+
+
+def _subset(terms: Terms, sl: slice) -> Terms:
+    out = Terms(**terms.__dict__)
+    for k in ("obs2", "w2", "dirs", "wd", "obs3", "w3"):
+        v = getattr(terms, k)
+        if v is not None:
+            setattr(out, k, v[sl])
+    return out
+
+
+def pelvis_axis(model: PoseModel, axis: int) -> int:
+    return int(np.nonzero((model.dof_joint == 0) & (model.dof_axis == axis))[0][0])
+
+
+def fill(x: np.ndarray, fallback: float) -> np.ndarray:
+    """Linear interpolation over NaN (constant at the ends)."""
+    x = np.asarray(x, float)
+    ok = np.isfinite(x)
+    if not ok.any():
+        return np.full_like(x, fallback)
+    idx = np.arange(len(x))
+    return np.interp(idx, idx[ok], x[ok])
+
+
+def fill2(x: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+    return np.stack([fill(x[:, k], fallback[k]) for k in range(x.shape[1])], axis=1)
+
+
+def to_result(model, params, fps, times, conf, usable) -> FitResult:
+    T = params.shape[0]
+    angles = model.angles(params)
+    # Pelvis turns are unbounded during the fit; report them in (-pi, pi].
+    angles[:, 0] = np.angle(np.exp(1j * angles[:, 0]))
+    joints = model.forward(params)[:, :_J]
+    root = params[:, :3].copy()
+    bad = ~usable
+    joints[bad], angles[bad], root[bad] = np.nan, np.nan, np.nan
+    conf = np.where(usable[:, None], np.clip(conf, 0.0, 1.0), 0.0)
+    times = np.arange(T) / fps if times is None else np.asarray(times, float)
+    if times.shape != (T,):
+        raise FittingError(f"times must have shape ({T},), got {times.shape}")
+    return FitResult(fps=float(fps), times=times, joints=joints, angles=angles, root=root,
+                     confidence=conf, offsets=model.offsets[:_J].copy())
+
+
+def check_fps(fps):
+    if not (np.isfinite(fps) and fps > 0):
+        raise FittingError(f"fps must be a positive number, got {fps!r}")

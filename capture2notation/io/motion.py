@@ -1,0 +1,176 @@
+"""Motion from files: BVH, Kinect v2 CSV and truth sidecars, all in one form.
+
+Every source lands in :class:`MotionData` — the fields of a
+:class:`~capture2notation.fitting.FitResult` plus ``source`` — in our world
+frame (z up, metres, floor z = 0, the performer starting at the origin and
+facing +y).  Sources that only give joint positions in their own skeleton
+(BVH, Kinect) are mapped onto our joints by name and then fitted with
+:func:`~capture2notation.fitting.fit_points3d`, so ``joints`` and ``angles``
+are consistent (per-clip segment lengths in ``offsets``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..body import JOINTS, Body, joint_index
+from ..errors import MotionFileError
+from ..fitting.fit3d import fit_points3d
+from ..fitting.model import PoseModel
+from ..fitting.result import FitResult
+from .bvh import parse_bvh, read_bvh_points, read_own_bvh
+from .kinect import kinect_points, read_kinect_csv
+
+__all__ = ["MotionData", "read_motion", "normalise_world", "motion_from_truth"]
+
+
+@dataclass(frozen=True, eq=False)
+class MotionData(FitResult):
+    """A motion read from a file (fields of :class:`FitResult`).
+
+    Attributes
+    ----------
+    source : str
+        ``"bvh"``, ``"kinect"`` or ``"truth"``.
+    """
+
+    source: str = ""
+
+
+def read_motion(path, joint_map: dict | None = None, body: Body | None = None) -> MotionData:
+    """Read a motion file, dispatching on its extension.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.bvh`` (any common skeleton), ``.csv`` (Kinect v2 skeleton CSV,
+        LabanotationSuite format) or ``.npz`` (truth sidecar).
+    joint_map : dict, optional
+        BVH only: source joint name -> our joint name, overriding the name table.
+    body : Body, optional
+        Proportions for segments the source does not measure (default ``Body()``).
+
+    Returns
+    -------
+    MotionData
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise MotionFileError(f"{path}: no such motion file")
+    ext = path.suffix.lower()
+    if ext == ".bvh":
+        skel = parse_bvh(path)
+        own = None if joint_map else read_own_bvh(skel)
+        if own is not None:  # our skeleton: angles are exact, already in our world frame
+            return _own_motion(skel.fps, *own)
+        points, conf, head, fps = read_bvh_points(skel, joint_map, where=path)
+        head_c = None if head is None else np.ones(len(head))
+        return _fit(points, conf, head, head_c, fps, None, body, "bvh")
+    if ext == ".csv":
+        times, pos, kconf, fps = read_kinect_csv(path)
+        points, conf, head, head_c = kinect_points(pos, kconf)
+        if not np.any(conf > 0):
+            raise MotionFileError(f"{path}: no tracked joints in any row")
+        return _fit(points, conf, head, head_c, fps, times, body, "kinect")
+    if ext == ".npz":
+        return motion_from_truth(path)
+    raise MotionFileError(f"{path}: unknown motion file type {ext!r}; expected .bvh, .csv (Kinect v2) or .npz (truth)")
+
+
+def _own_motion(fps, angles, root, offsets) -> MotionData:
+    model = PoseModel(Body(), offsets)
+    joints = model.forward(model.params(angles, root))[:, : len(JOINTS)]
+    T = angles.shape[0]
+    return MotionData(fps=fps, times=np.arange(T) / fps, joints=joints, angles=angles, root=root,
+                      confidence=np.ones((T, len(JOINTS))), offsets=offsets, source="bvh")
+
+
+def _fit(points, conf, head, head_c, fps, times, body, source) -> MotionData:
+    extra = [] if head is None else [head]
+    points, extra = normalise_world(points, conf, extra)
+    virtual = {} if head is None else {"head_centre": (extra[0], head_c)}
+    res = fit_points3d(points, conf, fps, body=body, times=times, virtual=virtual)
+    return MotionData(**{k: getattr(res, k) for k in res.__dataclass_fields__}, source=source)
+
+
+def motion_from_truth(path) -> MotionData:
+    """A truth sidecar as :class:`MotionData` (confidence 1 wherever joints are finite)."""
+    from .truth import read_truth
+
+    tr = read_truth(path)
+    names = [str(n) for n in np.asarray(tr.joint_names).tolist()]
+    J = len(JOINTS)
+    T = tr.times.shape[0]
+    order = []
+    for name in JOINTS:
+        if name not in names:
+            raise MotionFileError(f"{path}: truth sidecar has no joint {name!r} (it has {', '.join(names)})")
+        order.append(names.index(name))
+    joints = np.asarray(tr.joints, float)[:, order]
+    angles = np.asarray(tr.angles, float)[:, order]
+    conf = np.all(np.isfinite(joints), axis=-1).astype(float)
+    body = Body(float(tr.body_height))
+    return MotionData(fps=float(tr.fps), times=np.asarray(tr.times, float), joints=joints, angles=angles,
+                      root=np.asarray(tr.root, float).reshape(T, 3), confidence=conf.reshape(T, J),
+                      offsets=np.array(body.offsets), source="truth")
+
+
+def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
+    """Floor at z = 0, start at the origin, initially facing +y.
+
+    Parameters
+    ----------
+    points : (T, J, 3) ndarray
+        Our joints, z up, metres (NaN where missing).
+    confidence : (T, J) ndarray
+    extra : sequence of (T, 3) ndarray
+        Other points to move with the body.
+
+    Returns
+    -------
+    points : (T, J, 3) ndarray
+    extra : list of (T, 3) ndarray
+
+    Notes
+    -----
+    The floor is the 2nd percentile over frames of the lowest foot point,
+    less that point's rest height (so a toe rests at its model height);
+    the facing is the horizontal right-hip − left-hip direction (shoulders
+    if the hips are missing), median over the first second of valid frames.
+    """
+    points = np.asarray(points, float)
+    conf = np.asarray(confidence, float)
+    ok = (conf > 0) & np.all(np.isfinite(points), axis=-1)
+    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
+    rest = Body().rest
+    fz = np.where(ok[:, feet], points[:, feet, 2] - rest[feet, 2], np.nan)
+    if not np.any(np.isfinite(fz)):
+        raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
+    floor = np.nanpercentile(np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2)
+    right = None
+    for a, b in (("right_hip", "left_hip"), ("right_shoulder", "left_shoulder")):
+        ia, ib = joint_index(a), joint_index(b)
+        both = np.nonzero(ok[:, ia] & ok[:, ib])[0]
+        if both.size:
+            first = both[: max(1, min(both.size, 30))]
+            d = np.median(points[first, ia] - points[first, ib], axis=0)
+            if np.hypot(d[0], d[1]) > 1e-6:
+                right = d
+                break
+    if right is None:
+        raise MotionFileError("neither the hips nor the shoulders are ever tracked: cannot find the facing")
+    yaw = np.arctan2(right[1], right[0])  # rotate by -yaw so right -> +x
+    c, s = np.cos(-yaw), np.sin(-yaw)
+    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    pel = joint_index("pelvis")
+    start_frames = np.nonzero(ok[:, pel])[0]
+    centre = points[start_frames[0], pel] if start_frames.size else np.nanmean(points[0], axis=0)
+    shift = np.array([centre[0], centre[1], floor])
+
+    def move(p):
+        return (np.asarray(p, float) - shift) @ Rz.T
+
+    return move(points), [move(e) for e in extra]

@@ -1,0 +1,209 @@
+"""The truth sidecar ``truth.npz`` written beside every rendered video.
+
+Fields (ARCHITECTURE.md, "Truth sidecar"); T frames, J joints:
+
+==============  ===========  ==================================================
+field           shape        meaning
+==============  ===========  ==================================================
+fps             ()           frames per second
+times           (T,)         seconds
+joint_names     (J,)         joint names (str)
+joints          (T, J, 3)    world joint positions, metres (z up, floor z = 0)
+angles          (T, J, 3)    local Euler angles, radians
+root            (T, 3)       pelvis position, metres
+landmarks3d     (T, 33, 3)   world positions of the 33 BlazePose landmarks
+keypoints       (T, 33, 2)   their pixel projections
+visibility      (T, 33)      1 visible, 0 self-occluded or off-image
+K               (3, 3)       camera intrinsics
+R               (3, 3)       world-to-camera rotation
+t               (3,)         ``x_cam = R @ x_world + t`` (OpenCV camera)
+image_size      (2,)         (width, height), pixels
+score           ()           JSON text of the score
+effort          ()           JSON text of the Effort
+view            ()           viewpoint name
+style           ()           rendering style
+body_height     ()           metres
+==============  ===========  ==================================================
+
+Stored with ``numpy.savez`` without pickles (strings as unicode arrays).
+"""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MotionFileError
+from .atomic import atomic_path
+
+__all__ = ["TRUTH_FIELDS", "Truth", "read_truth", "write_truth"]
+
+# name -> shape pattern: ints are fixed sizes, "T"/"J" are shared free sizes,
+# None marks a text scalar.
+TRUTH_FIELDS: dict[str, tuple | None] = {
+    "fps": (),
+    "times": ("T",),
+    "joint_names": ("J",),
+    "joints": ("T", "J", 3),
+    "angles": ("T", "J", 3),
+    "root": ("T", 3),
+    "landmarks3d": ("T", 33, 3),
+    "keypoints": ("T", 33, 2),
+    "visibility": ("T", 33),
+    "K": (3, 3),
+    "R": (3, 3),
+    "t": (3,),
+    "image_size": (2,),
+    "score": None,
+    "effort": None,
+    "view": None,
+    "style": None,
+    "body_height": (),
+}
+_TEXT = {"joint_names"} | {k for k, v in TRUTH_FIELDS.items() if v is None}
+
+
+@dataclass(frozen=True, eq=False)
+class Truth:
+    """Contents of a truth sidecar (see the module docstring for the fields)."""
+
+    fps: float
+    times: np.ndarray
+    joint_names: tuple
+    joints: np.ndarray
+    angles: np.ndarray
+    root: np.ndarray
+    landmarks3d: np.ndarray
+    keypoints: np.ndarray
+    visibility: np.ndarray
+    K: np.ndarray
+    R: np.ndarray
+    t: np.ndarray
+    image_size: tuple
+    score: str
+    effort: str
+    view: str
+    style: str
+    body_height: float
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.times.shape[0])
+
+
+def _validate(arrays: dict, where: str) -> dict:
+    """Check names, dtypes and shapes; return normalised arrays."""
+    missing = [k for k in TRUTH_FIELDS if k not in arrays]
+    extra = [k for k in arrays if k not in TRUTH_FIELDS]
+    if missing:
+        raise MotionFileError(f"{where}: truth sidecar lacks field(s) {', '.join(missing)}")
+    if extra:
+        raise MotionFileError(
+            f"{where}: unknown truth field(s) {', '.join(extra)}; expected {', '.join(TRUTH_FIELDS)}"
+        )
+    sizes: dict[str, int] = {}
+    out = {}
+    for name, pattern in TRUTH_FIELDS.items():
+        value = arrays[name]
+        if name in _TEXT:
+            arr = np.asarray(value)
+            if arr.dtype.kind not in "UO" and not (arr.dtype.kind == "S"):
+                raise MotionFileError(f"{where}: field {name} must be text, got dtype {arr.dtype}")
+            arr = arr.astype(str)
+            if pattern is None and arr.shape != ():
+                raise MotionFileError(f"{where}: field {name} must be a single string, got shape {arr.shape}")
+        else:
+            try:
+                arr = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                raise MotionFileError(f"{where}: field {name} must be numeric, got {type(value).__name__}") from None
+        if pattern is not None:
+            if arr.ndim != len(pattern):
+                raise MotionFileError(
+                    f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)}"
+                )
+            for dim, want in zip(arr.shape, pattern):
+                if isinstance(want, str):
+                    if sizes.setdefault(want, dim) != dim:
+                        raise MotionFileError(
+                            f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)} "
+                            f"with {want} = {sizes[want]} as in the other fields"
+                        )
+                elif dim != want:
+                    raise MotionFileError(f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)}")
+        out[name] = arr
+    if not (np.isfinite(out["fps"]) and out["fps"] > 0):
+        raise MotionFileError(f"{where}: field fps must be positive, got {out['fps']}")
+    if not (np.isfinite(out["body_height"]) and out["body_height"] > 0):
+        raise MotionFileError(f"{where}: field body_height must be positive, got {out['body_height']}")
+    vis = out["visibility"]
+    if np.any((vis < 0) | (vis > 1) | np.isnan(vis)):
+        raise MotionFileError(f"{where}: field visibility must lie in [0, 1]")
+    return out
+
+
+def _fmt(pattern) -> str:
+    return "(" + ", ".join(str(p) for p in pattern) + ("," if len(pattern) == 1 else "") + ")"
+
+
+def write_truth(path, **fields_) -> Path:
+    """Validate and atomically write a truth sidecar.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination, normally ``OUTDIR/truth.npz``.
+    **fields_
+        Every field of :data:`TRUTH_FIELDS`, no others (text fields as str).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    MotionFileError
+        A field is missing, unknown or has the wrong shape (names the file and field).
+    """
+    path = Path(path)
+    arrays = _validate(fields_, str(path))
+    with atomic_path(path, suffix=".npz") as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    return path
+
+
+def read_truth(path) -> Truth:
+    """Read and validate a truth sidecar.
+
+    Raises
+    ------
+    MotionFileError
+        Unreadable file, missing field or wrong shape (names the file and field).
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {k: npz[k] for k in npz.files}
+    except FileNotFoundError:
+        raise MotionFileError(f"{path}: truth sidecar not found") from None
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+        raise MotionFileError(f"{path}: not a readable truth sidecar (.npz): {exc}") from None
+    a = _validate(arrays, str(path))
+    kw = {}
+    for f in fields(Truth):
+        v = a[f.name]
+        if f.name in ("fps", "body_height"):
+            v = float(v)
+        elif f.name == "joint_names":
+            v = tuple(str(s) for s in v)
+        elif f.name == "image_size":
+            v = (int(v[0]), int(v[1]))
+        elif f.name in _TEXT:
+            v = str(v)
+        else:
+            v.setflags(write=False)
+        kw[f.name] = v
+    return Truth(**kw)

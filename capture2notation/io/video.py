@@ -1,0 +1,279 @@
+"""Video input (files and image folders) and an atomic video writer.
+
+Frames are streamed one at a time, so memory stays constant whatever the
+length.  Timestamps come from the container (``CAP_PROP_POS_MSEC``) when it
+gives increasing values, else from the frame index and frame rate.  A file
+that ends early or has a frame that cannot be decoded yields the frames read
+so far and a :func:`warnings.warn` naming the first bad frame; a file with no
+readable frame raises :class:`~capture2notation.errors.VideoError`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..errors import VideoError
+from .atomic import atomic_path
+
+__all__ = [
+    "VIDEO_EXTENSIONS",
+    "IMAGE_EXTENSIONS",
+    "Frame",
+    "VideoInfo",
+    "probe",
+    "iter_frames",
+    "VideoWriter",
+]
+
+VIDEO_EXTENSIONS = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm")
+IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+DEFAULT_FOLDER_FPS = 30.0
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One decoded frame.
+
+    Attributes
+    ----------
+    index : int
+        0-based frame number in the source.
+    time : float
+        Timestamp, seconds from the start.
+    image : (H, W, 3) uint8 ndarray
+        BGR pixels (OpenCV order).
+    """
+
+    index: int
+    time: float
+    image: np.ndarray
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    """What a video source declares about itself.
+
+    Attributes
+    ----------
+    path : Path
+    fps : float
+        Frames per second (declared by the container, or given for folders).
+    frame_count : int
+        Declared number of frames (may be wrong for damaged files).
+    width, height : int
+        Frame size in pixels.
+    """
+
+    path: Path
+    fps: float
+    frame_count: int
+    width: int
+    height: int
+
+    @property
+    def image_size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return (self.width, self.height)
+
+
+def _folder_images(path: Path) -> list[Path]:
+    return sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_EXTENSIONS and p.is_file())
+
+
+def _open_capture(path: Path) -> cv2.VideoCapture:
+    cap = cv2.VideoCapture(str(path))
+    if not cap.isOpened():
+        cap.release()
+        raise VideoError(f"{path}: OpenCV cannot open this video; expected an mp4/avi/mov file or an image folder")
+    return cap
+
+
+def probe(path, fps: float | None = None) -> VideoInfo:
+    """Describe a video file or image folder without decoding it all.
+
+    Parameters
+    ----------
+    path : str or Path
+        Video file or folder of images (sorted by name).
+    fps : float, optional
+        Frame rate of an image folder (default 30), or an override for a file
+        whose container declares none.
+
+    Raises
+    ------
+    VideoError
+        Missing path, unopenable file, empty folder or unreadable first image.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise VideoError(f"{path}: no such video file or image folder")
+    if path.is_dir():
+        images = _folder_images(path)
+        if not images:
+            raise VideoError(f"{path}: image folder has no {'/'.join(IMAGE_EXTENSIONS)} files")
+        first = cv2.imread(str(images[0]), cv2.IMREAD_COLOR)
+        if first is None:
+            raise VideoError(f"{images[0]}: cannot decode image (frame 0 of folder {path})")
+        rate = DEFAULT_FOLDER_FPS if fps is None else float(fps)
+        return VideoInfo(path, rate, len(images), first.shape[1], first.shape[0])
+    cap = _open_capture(path)
+    try:
+        declared = cap.get(cv2.CAP_PROP_FPS)
+        rate = float(fps) if fps is not None else float(declared)
+        if not np.isfinite(rate) or rate <= 0:
+            raise VideoError(f"{path}: container declares frame rate {declared!r}; pass fps= explicitly")
+        return VideoInfo(
+            path,
+            rate,
+            int(cap.get(cv2.CAP_PROP_FRAME_COUNT)),
+            int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)),
+            int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)),
+        )
+    finally:
+        cap.release()
+
+
+def _iter_folder(info: VideoInfo, start: int, stop: int | None) -> Iterator[Frame]:
+    images = _folder_images(info.path)[start:stop]
+    for offset, file in enumerate(images):
+        index = start + offset
+        image = cv2.imread(str(file), cv2.IMREAD_COLOR)
+        if image is None or image.shape[:2] != (info.height, info.width):
+            problem = "cannot be decoded" if image is None else f"has size {image.shape[1]}x{image.shape[0]}"
+            _stop_early(info.path, index, f"image {file.name} {problem} (expected {info.width}x{info.height})")
+            return
+        yield Frame(index, index / info.fps, image)
+
+
+def _stop_early(path: Path, index: int, why: str) -> None:
+    if index == 0:
+        raise VideoError(f"{path}: no frame could be read: {why}")
+    warnings.warn(
+        f"{path}: stopped at frame {index} ({why}); using the {index} frames read before it",
+        RuntimeWarning,
+        stacklevel=3,
+    )
+
+
+def _iter_file(info: VideoInfo, start: int, stop: int | None) -> Iterator[Frame]:
+    cap = _open_capture(info.path)
+    try:
+        if start:
+            cap.set(cv2.CAP_PROP_POS_FRAMES, start)
+        index = start
+        last_time = -np.inf
+        while stop is None or index < stop:
+            ok, image = cap.read()
+            if not ok or image is None:
+                if index < info.frame_count:
+                    _stop_early(info.path, index, f"frame cannot be decoded; the file declares {info.frame_count} frames")
+                elif index == 0:
+                    raise VideoError(f"{info.path}: no frame could be read")
+                return
+            msec = cap.get(cv2.CAP_PROP_POS_MSEC)
+            # Container timestamps keep variable frame rates exact; fall back to
+            # index / fps when the backend reports nothing sensible.
+            t = msec / 1000.0 if np.isfinite(msec) and msec / 1000.0 > last_time else index / info.fps
+            last_time = t
+            yield Frame(index, t, image)
+            index += 1
+    finally:
+        cap.release()
+
+
+def iter_frames(path, *, fps: float | None = None, start: int = 0, stop: int | None = None) -> Iterator[Frame]:
+    """Stream the frames of a video file or image folder.
+
+    Parameters
+    ----------
+    path : str or Path
+        Video file (mp4/avi/mov/...) or folder of images sorted by name.
+    fps : float, optional
+        Frame rate for image folders (default 30) or to override the container.
+    start, stop : int
+        Frame range ``[start, stop)``.
+
+    Yields
+    ------
+    Frame
+        ``index``, ``time`` (s) and BGR ``image`` (H, W, 3) uint8.
+
+    Warns
+    -----
+    RuntimeWarning
+        The source ends before its declared length or a frame cannot be
+        decoded; the message names the first bad frame.
+
+    Raises
+    ------
+    VideoError
+        No frame at all can be read.
+    """
+    info = probe(path, fps=fps)
+    if start < 0 or (stop is not None and stop < start):
+        raise VideoError(f"{path}: bad frame range start={start}, stop={stop}; expected 0 <= start <= stop")
+    if info.path.is_dir():
+        yield from _iter_folder(info, start, stop)
+    else:
+        yield from _iter_file(info, start, stop)
+
+
+class VideoWriter:
+    """Write BGR frames to a video file atomically (the file appears on close).
+
+    Parameters
+    ----------
+    path : str or Path
+        Output file; ``.mp4`` uses the ``mp4v`` codec, ``.avi`` ``MJPG``.
+    fps : float
+        Frame rate.
+    size : (int, int)
+        (width, height) of every frame.
+
+    Examples
+    --------
+    >>> with VideoWriter("out.mp4", 25, (640, 480)) as w:  # doctest: +SKIP
+    ...     w.write(frame)
+    """
+
+    _FOURCC = {".avi": "MJPG", ".mp4": "mp4v", ".mov": "mp4v", ".m4v": "mp4v"}
+
+    def __init__(self, path, fps: float, size: tuple[int, int]):
+        self.path = Path(path)
+        self.fps = float(fps)
+        self.size = (int(size[0]), int(size[1]))
+        self.frames_written = 0
+        self._ctx = None
+        self._writer = None
+
+    def __enter__(self) -> VideoWriter:
+        suffix = self.path.suffix.lower()
+        if suffix not in self._FOURCC:
+            raise VideoError(f"{self.path}: cannot write video with extension {suffix!r}; expected one of {sorted(self._FOURCC)}")
+        self._ctx = atomic_path(self.path)
+        tmp = self._ctx.__enter__()
+        self._writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*self._FOURCC[suffix]), self.fps, self.size)
+        if not self._writer.isOpened():
+            self._ctx.__exit__(VideoError, None, None)
+            raise VideoError(f"{self.path}: OpenCV cannot open a video writer ({self._FOURCC[suffix]}, {self.fps} fps, {self.size})")
+        return self
+
+    def write(self, image: np.ndarray) -> None:
+        """Append one BGR (H, W, 3) uint8 frame of the declared size."""
+        if image.shape[:2] != (self.size[1], self.size[0]):
+            raise VideoError(
+                f"{self.path}: frame {self.frames_written} has size {image.shape[1]}x{image.shape[0]}, "
+                f"expected {self.size[0]}x{self.size[1]}"
+            )
+        self._writer.write(np.ascontiguousarray(image, dtype=np.uint8))
+        self.frames_written += 1
+
+    def __exit__(self, exc_type, exc, tb):
+        self._writer.release()
+        return self._ctx.__exit__(exc_type, exc, tb)

@@ -1,0 +1,313 @@
+"""BlazePose (full) landmarks with onnxruntime, without the person detector.
+
+MediaPipe finds the person with a detector model whose TFLite uses an
+operator the converter lacks, so the person is localised with the landmark
+model alone, the way MediaPipe tracks between frames
+(``pose_landmark_cpu.pbtxt``):
+
+1. *acquire*: run the model on the whole frame, letterboxed to a square;
+2. *refine*: the auxiliary points 33 (hip centre) and 34 (full-body scale
+   point) define the next crop as in ``PoseLandmarksToRoi``
+   (``AlignmentPointsRectsCalculator`` then ``RectTransformationCalculator``):
+   centre = point 33, side = 2·|p34 − p33| × 1.25, rotation making p33→p34
+   point up; run again on that crop (twice by default);
+3. *track*: on video, the next frame's crop comes from this frame's
+   (smoothed) auxiliary points; when the pose-present score falls below 0.5
+   the person is re-acquired from the full frame.
+
+Positions are refined with the heatmaps (:mod:`.heatmap`) and smoothed over
+time with MediaPipe's one-euro filter (:mod:`.filter`).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from ..errors import KeypointError, ModelError
+from .filter import AUX_FILTER, POSE_FILTER, VISIBILITY_ALPHA, WORLD_FILTER, LowPass, OneEuroFilter, object_scale
+from .heatmap import refine_from_heatmap
+from .model import INPUT_SHAPE, resolve_model
+
+__all__ = [
+    "PoseEstimate",
+    "BlazePose",
+    "make_session",
+    "full_frame_crop",
+    "crop_from_aux",
+    "crop_matrix",
+    "crop_to_tensor",
+    "decode_outputs",
+]
+
+logger = logging.getLogger(__name__)
+
+INPUT_SIZE = INPUT_SHAPE[-1]
+NUM_ALL = 39  # 33 body landmarks + aux 33, 34 + 4 unused
+ROI_SCALE = 1.25  # RectTransformationCalculator scale_x/scale_y in PoseLandmarksToRoi
+PRESENCE_THRESHOLD = 0.5  # ThresholdingCalculator in the pose graph
+
+
+@dataclass
+class PoseEstimate:
+    """The model's answer for one frame, in image coordinates.
+
+    Attributes
+    ----------
+    xy : (33, 3) ndarray
+        Pixel x, y and z (z in pixels, the scale of x; smaller = closer).
+    visibility : (33,) ndarray
+        Sigmoid of the visibility logit.
+    presence : float
+        Pose-present probability (the model's pose flag).
+    world : (33, 3) ndarray
+        World landmarks, metres, rotated back into the image axes.
+    aux : (2, 2) ndarray
+        Pixel positions of auxiliary points 33 and 34.
+    crop : (5,) ndarray
+        Crop that produced this answer: cx, cy, w, h (pixels), rotation (rad).
+    """
+
+    xy: np.ndarray
+    visibility: np.ndarray
+    presence: float
+    world: np.ndarray
+    aux: np.ndarray
+    crop: np.ndarray
+
+
+def make_session(model=None, threads: int = 2):
+    """An onnxruntime CPU session for the pose model, built once and reused.
+
+    Parameters
+    ----------
+    model : str or Path, optional
+        ONNX file; default :func:`~capture2notation.keypoints.model.resolve_model`.
+    threads : int
+        Intra-op threads (the landmark model gains little beyond 2).
+    """
+    import onnx
+    import onnxruntime as ort
+    from onnx.utils import Extractor
+
+    path = resolve_model(model)
+    try:
+        graph = onnx.load(str(path))
+        outputs = [o.name for o in graph.graph.output]
+        # Drop the segmentation head (output 2): nothing here uses it and
+        # onnxruntime runs every node of the graph, wanted or not (~20 %).
+        keep = [name for i, name in enumerate(outputs) if i != 2] if len(outputs) == 5 else outputs
+        pruned = Extractor(graph).extract_model([i.name for i in graph.graph.input], keep).SerializeToString()
+    except Exception as exc:  # onnx raises many untyped errors on bad files
+        raise ModelError(f"{path}: cannot read the pose model as ONNX: {exc}") from exc
+    opts = ort.SessionOptions()
+    opts.intra_op_num_threads = int(threads)
+    opts.inter_op_num_threads = 1
+    opts.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
+    # Full graph optimisation fuses Conv+Clip and roughly halves the run time
+    # against the basic level; building it takes < 0.1 s, so no cached copy.
+    opts.graph_optimization_level = ort.GraphOptimizationLevel.ORT_ENABLE_ALL
+    try:
+        return ort.InferenceSession(pruned, opts, providers=["CPUExecutionProvider"])
+    except Exception as exc:  # onnxruntime raises untyped errors
+        raise ModelError(f"{path}: onnxruntime cannot load the pose model: {exc}") from exc
+
+
+def full_frame_crop(width: int, height: int) -> np.ndarray:
+    """The square crop that letterboxes the whole frame: (cx, cy, side, side, 0)."""
+    side = float(max(width, height))
+    return np.array([width / 2.0, height / 2.0, side, side, 0.0])
+
+
+def crop_from_aux(aux: np.ndarray, scale: float = ROI_SCALE) -> np.ndarray:
+    """MediaPipe's pose ROI from the two auxiliary points.
+
+    Parameters
+    ----------
+    aux : (2, 2) ndarray
+        Pixel positions of point 33 (centre) and point 34 (scale/rotation).
+    scale : float
+        Margin factor (1.25 in ``pose_landmarks_to_roi.pbtxt``).
+
+    Returns
+    -------
+    (5,) ndarray
+        cx, cy, w, h in pixels (square) and rotation in radians, clockwise in
+        the image, such that the centre→scale-point vector points up.
+    """
+    (x0, y0), (x1, y1) = np.asarray(aux, dtype=float)
+    side = 2.0 * np.hypot(x1 - x0, y1 - y0) * scale
+    rotation = np.pi / 2 - np.arctan2(-(y1 - y0), x1 - x0)
+    rotation = rotation - 2 * np.pi * np.floor((rotation + np.pi) / (2 * np.pi))
+    return np.array([x0, y0, side, side, rotation])
+
+
+def _rotation(theta: float) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def crop_matrix(crop: np.ndarray, size: int = INPUT_SIZE) -> np.ndarray:
+    """Affine (2, 3) matrix mapping image pixels to model-input pixels.
+
+    The crop's corners map to the input's corners (MediaPipe's
+    ``ImageToTensorCalculator`` convention), so normalised model coordinates
+    ``uv`` map back with ``p = c + R(rot) @ ((uv - 0.5) * (w, h))``.
+    """
+    cx, cy, w, h, rot = crop
+    a = np.diag([size / w, size / h]) @ _rotation(rot).T
+    b = size / 2.0 - a @ np.array([cx, cy])
+    return np.hstack([a, b[:, None]])
+
+
+def crop_to_tensor(image: np.ndarray, crop: np.ndarray, border: int = cv2.BORDER_REPLICATE) -> np.ndarray:
+    """Cut the crop out of a BGR frame as the model's (1, 3, 256, 256) RGB input in [0, 1]."""
+    patch = cv2.warpAffine(
+        image, crop_matrix(crop), (INPUT_SIZE, INPUT_SIZE), flags=cv2.INTER_LINEAR, borderMode=border
+    )
+    rgb = cv2.cvtColor(patch, cv2.COLOR_BGR2RGB)
+    return (rgb.transpose(2, 0, 1)[None].astype(np.float32)) * np.float32(1.0 / 255.0)
+
+
+def _sigmoid(x):
+    return 1.0 / (1.0 + np.exp(-np.asarray(x, dtype=float)))
+
+
+def decode_outputs(outputs, crop: np.ndarray, refine: bool = True) -> PoseEstimate:
+    """Turn the model's outputs for one crop into image-space landmarks.
+
+    Parameters
+    ----------
+    outputs : sequence of ndarray
+        Model outputs: landmarks (1, 195), pose flag (1, 1), heatmaps
+        (1, 39, 64, 64), world landmarks (1, 117) — the segmentation output
+        is pruned by :func:`make_session`; a full 5-output list is accepted.
+    crop : (5,) ndarray
+        The crop the input was cut from.
+    refine : bool
+        Apply the heatmap refinement (MediaPipe does).
+    """
+    if len(outputs) == 5:
+        outputs = [outputs[i] for i in (0, 1, 3, 4)]
+    raw = np.asarray(outputs[0], dtype=float).reshape(NUM_ALL, 5)
+    uv = raw[:, :2] / INPUT_SIZE
+    if refine:
+        uv, _ = refine_from_heatmap(uv, np.asarray(outputs[2])[0])
+    cx, cy, w, h, rot = crop
+    rmat = _rotation(rot)
+    xy = ((uv - 0.5) * np.array([w, h])) @ rmat.T + np.array([cx, cy])
+    z = raw[:, 2] / INPUT_SIZE * w
+    world = np.asarray(outputs[3], dtype=float).reshape(NUM_ALL, 3)
+    world_xy = world[:, :2] @ rmat.T
+    return PoseEstimate(
+        xy=np.column_stack([xy, z])[:33],
+        visibility=_sigmoid(raw[:33, 3]),
+        presence=float(np.asarray(outputs[1]).ravel()[0]),
+        world=np.column_stack([world_xy, world[:, 2]])[:33],
+        aux=xy[33:35].copy(),
+        crop=np.asarray(crop, dtype=float).copy(),
+    )
+
+
+class BlazePose:
+    """BlazePose landmark estimator with person tracking and smoothing.
+
+    Parameters
+    ----------
+    model : str or Path, optional
+        ONNX model (default: ``$C2N_POSE_MODEL`` or the cache, fetched on first use).
+    threads : int
+        onnxruntime intra-op threads.
+    refinements : int
+        Crop refinements after the full-frame pass when (re-)acquiring.
+    presence_threshold : float
+        Below this pose-present score the frame has no person and the tracker
+        re-acquires from the full frame.
+    smooth : bool
+        Apply the one-euro filter on video (:meth:`process`).
+    session : onnxruntime.InferenceSession, optional
+        Reuse an existing session (the model is then not resolved again).
+    """
+
+    def __init__(
+        self,
+        model=None,
+        *,
+        threads: int = 2,
+        refinements: int = 2,
+        presence_threshold: float = PRESENCE_THRESHOLD,
+        smooth: bool = True,
+        session=None,
+    ):
+        self.session = session if session is not None else make_session(model, threads)
+        self._input_name = self.session.get_inputs()[0].name
+        self.refinements = int(refinements)
+        self.presence_threshold = float(presence_threshold)
+        self.smooth = bool(smooth)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the tracked crop and the filters (call between videos)."""
+        self._crop = None
+        self._f_xy = OneEuroFilter(*POSE_FILTER)
+        self._f_aux = OneEuroFilter(*AUX_FILTER)
+        self._f_world = OneEuroFilter(*WORLD_FILTER)
+        self._f_vis = LowPass(VISIBILITY_ALPHA)
+
+    def infer(self, image: np.ndarray, crop: np.ndarray) -> PoseEstimate:
+        """Run the model once on `crop` of a BGR frame (H, W, 3) uint8."""
+        outputs = self.session.run(None, {self._input_name: crop_to_tensor(image, crop)})
+        return decode_outputs(outputs, crop)
+
+    def estimate_image(self, image: np.ndarray) -> PoseEstimate:
+        """Locate the person in a still image: full frame, then refined crops."""
+        if image.ndim != 3 or image.shape[2] != 3:
+            raise KeypointError(f"expected a BGR image (H, W, 3), got shape {image.shape}")
+        est = self.infer(image, full_frame_crop(image.shape[1], image.shape[0]))
+        for _ in range(self.refinements):
+            if est.presence < self.presence_threshold:
+                break
+            est = self.infer(image, crop_from_aux(est.aux))
+        return est
+
+    def process(self, image: np.ndarray, t: float) -> PoseEstimate | None:
+        """Next video frame: track, re-acquire when lost, smooth.
+
+        Parameters
+        ----------
+        image : (H, W, 3) uint8 ndarray
+            BGR frame.
+        t : float
+            Timestamp, seconds (increasing).
+
+        Returns
+        -------
+        PoseEstimate or None
+            None when no person is found in this frame.
+        """
+        est = None
+        if self._crop is not None:
+            est = self.infer(image, self._crop)
+            if est.presence < self.presence_threshold:
+                logger.debug("t=%.3f s: pose lost (score %.2f), re-acquiring", t, est.presence)
+                est = None
+        if est is None:
+            self.reset()
+            est = self.estimate_image(image)
+            if est.presence < self.presence_threshold:
+                return None
+        if self.smooth:
+            # As in LandmarksSmoothingCalculator, each set's speed is measured
+            # in units of its own bounding-box size.
+            scale, aux_scale = object_scale(est.xy), object_scale(est.aux)
+            if np.isfinite(scale) and scale > 1e-6:
+                est.xy = self._f_xy(t, est.xy, 1.0 / scale)
+            if np.isfinite(aux_scale) and aux_scale > 1e-6:
+                est.aux = self._f_aux(t, est.aux, 1.0 / aux_scale)
+            est.world = self._f_world(t, est.world)
+            est.visibility = self._f_vis(est.visibility)
+        self._crop = crop_from_aux(est.aux)
+        return est

@@ -1,0 +1,176 @@
+"""Video → :class:`KeypointTrack`: the stage's entry points.
+
+:func:`extract` reads a video file or image folder; :func:`extract_frames`
+takes any iterable of frames (e.g. rendered in memory).  Both stream: memory
+grows only with the track (33 points per frame), never with the video.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from ..errors import KeypointError
+from ..io.video import Frame, iter_frames, probe
+from .track import NUM_LANDMARKS, KeypointTrack
+
+__all__ = ["BACKENDS", "extract", "extract_frames"]
+
+BACKENDS = ("blazepose", "markers")
+
+
+def _make_backend(backend: str, model, threads: int, smooth: bool, markers):
+    if backend == "blazepose":
+        from .blazepose import BlazePose
+
+        return BlazePose(model, threads=threads, smooth=smooth)
+    if backend == "markers":
+        from .markers import MarkerTracker
+
+        return MarkerTracker(markers)
+    raise KeypointError(f"unknown keypoint backend {backend!r}; expected one of {', '.join(BACKENDS)}")
+
+
+def extract_frames(
+    frames: Iterable,
+    fps: float,
+    *,
+    backend: str = "blazepose",
+    model=None,
+    threads: int = 2,
+    smooth: bool = True,
+    markers=None,
+    estimator=None,
+    progress=None,
+) -> KeypointTrack:
+    """Keypoints of a stream of frames.
+
+    Parameters
+    ----------
+    frames : iterable of Frame or (H, W, 3) uint8 ndarray
+        BGR frames in time order; bare arrays are timed ``index / fps``.
+    fps : float
+        Frame rate, frames per second.
+    backend : {"blazepose", "markers"}
+        Pose model or colour markers.
+    model : str or Path, optional
+        ONNX pose model (BlazePose only); default ``$C2N_POSE_MODEL`` or the cache.
+    threads : int
+        onnxruntime intra-op threads.
+    smooth : bool
+        One-euro smoothing (BlazePose only).
+    markers : sequence of MarkerSpec, optional
+        Marker colours (markers only); default the renderer's marker set.
+    estimator : BlazePose or MarkerTracker, optional
+        Reuse an existing estimator (its ONNX session); it is reset first and
+        its ``smooth`` flag set from `smooth`.
+    progress : callable, optional
+        Called with each processed frame index (e.g. a tqdm ``update``).
+
+    Returns
+    -------
+    KeypointTrack
+        Frames with no person (or no marker) are NaN with visibility 0.
+
+    Raises
+    ------
+    KeypointError
+        Unknown backend, no frames, or frames of changing size.
+    """
+    est = estimator if estimator is not None else _make_backend(backend, model, threads, smooth, markers)
+    if hasattr(est, "smooth"):
+        est.smooth = bool(smooth)
+    est.reset()
+    name = "markers" if type(est).__name__ == "MarkerTracker" else "blazepose"
+    times, xy, vis, pres, world, crops = [], [], [], [], [], []
+    size = None
+    for i, item in enumerate(frames):
+        frame = item if isinstance(item, Frame) else Frame(i, i / float(fps), np.asarray(item))
+        h, w = frame.image.shape[:2]
+        if size is None:
+            size = (w, h)
+        elif size != (w, h):
+            raise KeypointError(f"frame {frame.index} is {w}x{h}, expected {size[0]}x{size[1]} like frame 0")
+        r = est.process(frame.image, frame.time)
+        times.append(frame.time)
+        if r is None:
+            xy.append(np.full((NUM_LANDMARKS, 3), np.nan))
+            vis.append(np.zeros(NUM_LANDMARKS))
+            pres.append(0.0)
+            world.append(np.full((NUM_LANDMARKS, 3), np.nan))
+            crops.append(np.full(5, np.nan))
+        else:
+            xy.append(r.xy)
+            vis.append(r.visibility)
+            pres.append(r.presence)
+            world.append(r.world)
+            crops.append(r.crop)
+        if progress is not None:
+            progress(frame.index)
+    if size is None:
+        raise KeypointError("no frames to extract keypoints from")
+    return KeypointTrack(
+        fps=fps,
+        times=np.array(times),
+        image_size=np.array(size),
+        xy=np.array(xy),
+        visibility=np.clip(np.array(vis), 0.0, 1.0),
+        presence=np.array(pres),
+        world=np.array(world),
+        crops=np.array(crops),
+        backend=name,
+    )
+
+
+def extract(
+    video,
+    backend: str = "blazepose",
+    *,
+    model=None,
+    fps: float | None = None,
+    start: int = 0,
+    stop: int | None = None,
+    threads: int = 2,
+    smooth: bool = True,
+    markers=None,
+    estimator=None,
+    progress: bool = False,
+) -> KeypointTrack:
+    """Keypoints of a video file or image folder.
+
+    Parameters
+    ----------
+    video : str or Path
+        mp4/avi/mov file or folder of images.
+    backend : {"blazepose", "markers"}
+    model : str or Path, optional
+        ONNX pose model; default ``$C2N_POSE_MODEL`` or the cache (fetched on first use).
+    fps : float, optional
+        Frame rate of an image folder (default 30) or override for a file.
+    start, stop : int
+        Frame range ``[start, stop)``.
+    threads, smooth, markers, estimator
+        As :func:`extract_frames`.
+    progress : bool
+        Show a tqdm progress bar on stderr.
+
+    Returns
+    -------
+    KeypointTrack
+    """
+    info = probe(video, fps=fps)
+    frames = iter_frames(video, fps=fps, start=start, stop=stop)
+    if not progress:
+        return extract_frames(
+            frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
+            markers=markers, estimator=estimator,
+        )  # fmt: skip
+    from tqdm import tqdm
+
+    total = max(0, (info.frame_count if stop is None else min(stop, info.frame_count)) - start) or None
+    with tqdm(total=total, unit="frame", desc=f"keypoints ({backend})") as bar:
+        return extract_frames(
+            frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
+            markers=markers, estimator=estimator, progress=lambda _i: bar.update(1),
+        )  # fmt: skip

@@ -1,0 +1,231 @@
+"""How closely a captured score matches a reference score.
+
+Two scores can say the same thing in different words, so both are first put
+in a normal form (:func:`normalise`): a gesture symbol that moves a part to
+where it already is (its default standing pose or its previous destination)
+changes nothing and is dropped; so is a support symbol that keeps the same
+feet at the same level in place.  The support parts (``support``,
+``right_support``, ``left_support``) form one column, ``supports``, whose
+state is (part, direction, level).
+
+* :func:`symbol_agreement` — direction + level per part per beat: at each
+  sample beat, the destination written for each part (the last symbol that
+  has started, else the default) must be equal.
+* :func:`start_errors` — for each reference gesture symbol, the beat
+  distance to the nearest captured symbol of the same part with the same
+  destination.
+* :func:`score_differences` — exact comparison (start, duration, part,
+  direction, level, bend) of the normal forms; empty when they are equal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from ..errors import CompareError
+from ..notation.model import GESTURE_PARTS, Score, Symbol
+
+__all__ = [
+    "DEFAULT_STATE",
+    "Agreement",
+    "normalise",
+    "state_at",
+    "symbol_agreement",
+    "start_errors",
+    "compare_scores",
+    "score_differences",
+]
+
+#: Starting pose (DESIGN.md): limbs hang straight, head and chest upright,
+#: both feet support at middle level.
+DEFAULT_STATE = {p: ("place", "low", 0) for p in GESTURE_PARTS}
+DEFAULT_STATE.update({"head": ("place", "high", 0), "chest": ("place", "high", 0)})
+#: The support column: standing on both feet, in place, middle level.
+DEFAULT_SUPPORT = ("support", "place", "middle")
+
+
+def normalise(score: Score) -> Score:
+    """The normal form of `score` used for comparison (see module docstring)."""
+    state = dict(DEFAULT_STATE)
+    out: list[Symbol] = []
+    support = DEFAULT_SUPPORT
+    for s in score.symbols:
+        if s.is_support:
+            key = (s.part, s.direction, s.level)
+            if s.direction == "place" and key == support:
+                continue
+            support = key
+            out.append(s)
+            continue
+        key = (s.direction, s.level, s.bend)
+        if state.get(s.part) == key:
+            continue
+        state[s.part] = key
+        out.append(s)
+    return Score(symbols=tuple(out), title=score.title, tempo=score.tempo, meter=score.meter)
+
+
+def state_at(score: Score, part: str, beats) -> list[tuple]:
+    """Destination (direction, level) written for `part` at each beat.
+
+    Parameters
+    ----------
+    score : Score
+        Normalised score.
+    part : str
+        A gesture part, or ``"supports"`` for the support column.
+    beats : sequence of Fraction
+        Sorted sample beats.
+
+    Returns
+    -------
+    list of tuple
+        (direction, level) — (part, direction, level) for ``supports`` — of
+        the last symbol that has started at each beat, else the default.
+    """
+    if part == "supports":
+        syms = [s for s in score.symbols if s.is_support]
+        cur = DEFAULT_SUPPORT
+    else:
+        syms = [s for s in score.symbols if s.part == part]
+        cur = DEFAULT_STATE[part][:2]
+    out, i = [], 0
+    for b in beats:
+        while i < len(syms) and syms[i].start <= b:
+            s = syms[i]
+            cur = (s.part, s.direction, s.level) if part == "supports" else (s.direction, s.level)
+            i += 1
+        out.append(cur)
+    return out
+
+
+def _parts(ref: Score, cand: Score) -> list[str]:
+    used = {s.part for s in ref.symbols} | {s.part for s in cand.symbols}
+    parts = [p for p in DEFAULT_STATE if p in used]
+    if any(s.is_support for s in ref.symbols + cand.symbols):
+        parts.append("supports")
+    return parts
+
+
+def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> float:
+    """Fraction of (part, beat) cells where both scores write the same direction and level.
+
+    Parameters
+    ----------
+    ref, cand : Score
+        Any scores (normalised here); compared on their own beat scales.
+    step : Fraction
+        Sampling step in beats (1 = per beat).
+
+    Returns
+    -------
+    float
+        In [0, 1]; 1.0 when neither score writes anything.
+    """
+    ref, cand = normalise(ref), normalise(cand)
+    parts = _parts(ref, cand)
+    end = max(ref.duration, cand.duration)
+    n = int(np.ceil(end / step)) if end > 0 else 0
+    if not parts or n == 0:
+        return 1.0
+    beats = [k * step for k in range(n)]
+    same = total = 0
+    for p in parts:
+        a, b = state_at(ref, p, beats), state_at(cand, p, beats)
+        same += sum(x == y for x, y in zip(a, b))
+        total += n
+    return same / total
+
+
+def start_errors(ref: Score, cand: Score) -> tuple[np.ndarray, int]:
+    """Start-time errors of reference gesture symbols, beats.
+
+    Returns
+    -------
+    errors : (M,) ndarray
+        |start difference| to the nearest captured symbol of the same part
+        with the same destination, for each matched reference symbol.
+    unmatched : int
+        Reference gesture symbols with no such captured symbol.
+    """
+    ref, cand = normalise(ref), normalise(cand)
+    errs, missing = [], 0
+    for s in ref.symbols:
+        if s.is_support:
+            continue
+        starts = [c.start for c in cand.symbols if (c.part, c.direction, c.level) == (s.part, s.direction, s.level)]
+        if not starts:
+            missing += 1
+            continue
+        errs.append(float(min(abs(c - s.start) for c in starts)))
+    return np.asarray(errs, dtype=float), missing
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """Summary of :func:`compare_scores`.
+
+    Attributes
+    ----------
+    symbol_agreement : float
+        Direction + level per part per beat, in [0, 1].
+    median_start_error : float
+        Beats (NaN when nothing matched).
+    matched, unmatched : int
+        Reference gesture symbols with / without a captured counterpart.
+    exact : bool
+        The normal forms are identical.
+    """
+
+    symbol_agreement: float
+    median_start_error: float
+    matched: int
+    unmatched: int
+    exact: bool
+
+
+def compare_scores(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> Agreement:
+    """All agreement figures of `cand` against `ref`."""
+    if not isinstance(ref, Score) or not isinstance(cand, Score):
+        raise CompareError(f"compare_scores needs two Score objects, got {type(ref).__name__} and {type(cand).__name__}")
+    errs, missing = start_errors(ref, cand)
+    return Agreement(
+        symbol_agreement=symbol_agreement(ref, cand, step),
+        median_start_error=float(np.median(errs)) if errs.size else float("nan"),
+        matched=int(errs.size),
+        unmatched=int(missing),
+        exact=not score_differences(ref, cand),
+    )
+
+
+def _key(s: Symbol) -> tuple:
+    return (s.start, s.duration, s.part, s.direction, s.level, s.bend)
+
+
+def score_differences(ref: Score, cand: Score, supports: bool = True) -> list[str]:
+    """Symbols in one normal form and not the other, as readable lines.
+
+    Parameters
+    ----------
+    ref, cand : Score
+    supports : bool
+        Include support symbols in the comparison.
+
+    Returns
+    -------
+    list of str
+        ``"missing: …"`` (in `ref` only) and ``"extra: …"`` (in `cand` only).
+    """
+    a = {_key(s) for s in normalise(ref).symbols if supports or not s.is_support}
+    b = {_key(s) for s in normalise(cand).symbols if supports or not s.is_support}
+
+    def fmt(k):
+        start, dur, part, d, lv, bend = k
+        return f"{start} {dur} {part} {d} {lv}" + (f" bend={bend}" if bend else "")
+
+    return [f"missing: {fmt(k)}" for k in sorted(a - b, key=str)] + [
+        f"extra: {fmt(k)}" for k in sorted(b - a, key=str)
+    ]

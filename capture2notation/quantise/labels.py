@@ -1,0 +1,255 @@
+"""Per-frame Labanotation labels: direction, level and bend of every part.
+
+Every gesture part of :data:`~capture2notation.notation.PART_SEGMENTS` is
+classified with the shared thresholds of DESIGN.md
+(:func:`~capture2notation.notation.directions.classify_indices`), in the body
+frame (:func:`~capture2notation.body.body_frame`).  Supports follow DESIGN.md:
+a foot supports when it is within 3 cm of the floor and slower than
+0.2 m/s; its level is low when the knee bends more than 30° (plié), high when
+the heel is raised (relevé), else middle.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..body import JOINTS, Body, body_frame, joint_index
+from ..errors import QuantiseError
+from ..io.atomic import write_text
+from ..notation.directions import bend_angle, bend_degree, classify_indices
+from ..notation.model import DIRECTIONS, LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, SUPPORT_PARTS
+
+__all__ = [
+    "DIRECTION_NAMES",
+    "LABEL_PARTS",
+    "SUPPORT_HEIGHT_M",
+    "SUPPORT_SPEED_MS",
+    "PLIE_DEG",
+    "RELEVE_DEG",
+    "FrameLabels",
+    "label_frames",
+    "support_frames",
+    "write_labels_csv",
+]
+
+#: Direction names in the index order of ``classify_indices`` (8 = place).
+DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
+PLACE = DIRECTION_NAMES.index("place")
+MIDDLE = LEVELS.index("middle")
+#: Parts labelled per frame: every gesture part, then the supports.
+LABEL_PARTS: tuple[str, ...] = tuple(PART_SEGMENTS) + SUPPORT_PARTS
+
+SUPPORT_HEIGHT_M = 0.03
+SUPPORT_SPEED_MS = 0.2
+PLIE_DEG = 30.0
+#: The heel counts as raised when the foot (ankle → toe) points this much
+#: further below horizontal than at rest.
+RELEVE_DEG = 15.0
+
+_SIDES = ("right", "left")
+
+
+@dataclass(frozen=True)
+class FrameLabels:
+    """Labels of every part at every frame.
+
+    Attributes
+    ----------
+    times : (T,) ndarray
+        Seconds.
+    parts : tuple of str
+        :data:`LABEL_PARTS`.
+    direction : (T, P) ndarray of int
+        Index into :data:`DIRECTION_NAMES`; −1 where undefined (missing
+        joints, or a support part whose feet do not support).
+    level : (T, P) ndarray of int
+        Index into ``LEVELS``; −1 where undefined.
+    bend : (T, P) ndarray of int
+        Bend degree 0–6 for whole arms and legs; −1 elsewhere or when missing.
+    vectors : (T, P, 3) ndarray
+        Unit body-frame vectors of gesture parts (right, forward, up); NaN for
+        supports and missing joints.
+    bend_deg : (T, P) ndarray
+        Bend β in degrees for whole arms and legs, NaN elsewhere.
+    supporting : (T, 2) ndarray of bool
+        Right and left foot supporting.
+    support_level : (T, 2) ndarray of int
+        Level index of each foot's support, −1 when the foot does not support.
+    """
+
+    times: np.ndarray
+    parts: tuple
+    direction: np.ndarray
+    level: np.ndarray
+    bend: np.ndarray
+    vectors: np.ndarray
+    bend_deg: np.ndarray
+    supporting: np.ndarray
+    support_level: np.ndarray
+
+    def index(self, part: str) -> int:
+        """Column of `part`."""
+        try:
+            return self.parts.index(part)
+        except ValueError:
+            raise QuantiseError(f"no labels for part {part!r}; expected one of {' '.join(self.parts)}") from None
+
+
+def _rest_foot_pitch_deg(body: Body) -> float:
+    """Pitch of ankle → toe below horizontal at rest, degrees (proportional, so height-free)."""
+    d = body.rest[joint_index("right_toe")] - body.rest[joint_index("right_ankle")]
+    return float(np.degrees(np.arctan2(-d[2], np.hypot(d[0], d[1]))))
+
+
+def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Which feet support, and at which level, at every frame.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joints, metres, z up.
+    fps : float
+        Frames per second (for the foot speed).
+    floor : float
+        Floor height, metres.
+
+    Returns
+    -------
+    supporting : (T, 2) ndarray of bool
+        Right, left.
+    level : (T, 2) ndarray of int
+        Index into ``LEVELS`` (−1 where the foot does not support).
+    """
+    joints = np.asarray(joints, dtype=float)
+    T = joints.shape[0]
+    supporting = np.zeros((T, 2), bool)
+    level = np.full((T, 2), -1, int)
+    rest_pitch = _rest_foot_pitch_deg(Body())
+    for k, side in enumerate(_SIDES):
+        ankle = joints[:, joint_index(f"{side}_ankle")]
+        toe = joints[:, joint_index(f"{side}_toe")]
+        # The lowest point of the foot is the toe (flat or on demi-pointe);
+        # the ankle stands in for it when the toe is missing.
+        low = np.fmin(toe[:, 2], ankle[:, 2]) - floor
+        mid = 0.5 * (ankle + toe)
+        speed = np.full(T, np.nan)
+        if T > 1:
+            step = np.linalg.norm(np.diff(mid, axis=0), axis=-1) * fps
+            # Central speed where possible: the slower of the two adjacent steps
+            # so the first and last frames of a stance are not dropped.
+            speed[:-1] = step
+            speed[1:] = np.fmin(speed[1:], step)
+        else:
+            speed[:] = 0.0
+        sup = (low < SUPPORT_HEIGHT_M) & (speed < SUPPORT_SPEED_MS)
+        knee_bend = bend_angle(
+            joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")], ankle
+        )
+        d = toe - ankle
+        pitch = np.degrees(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
+        lev = np.full(T, MIDDLE)
+        lev = np.where(pitch > rest_pitch + RELEVE_DEG, LEVELS.index("high"), lev)
+        lev = np.where(knee_bend > PLIE_DEG, LEVELS.index("low"), lev)
+        supporting[:, k] = sup
+        level[:, k] = np.where(sup, lev, -1)
+    return supporting, level
+
+
+def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLabels:
+    """Label every part at every frame with the DESIGN.md thresholds.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joint positions, metres, z up (NaN where missing).
+    fps : float
+        Frames per second (> 0).
+    floor : float
+        Floor height in metres.
+
+    Returns
+    -------
+    FrameLabels
+
+    Notes
+    -----
+    Support parts: ``right_support`` / ``left_support`` are ``place`` at
+    their foot's level while that foot supports; ``support`` is ``place``
+    when both feet support at the same level.
+    """
+    joints = np.asarray(joints, dtype=float)
+    if joints.ndim != 3 or joints.shape[1:] != (len(JOINTS), 3):
+        raise QuantiseError(f"joints must have shape (T, {len(JOINTS)}, 3), got {joints.shape}")
+    if not (np.isfinite(fps) and fps > 0):
+        raise QuantiseError(f"fps must be a positive number, got {fps!r}")
+    T = joints.shape[0]
+    P = len(LABEL_PARTS)
+    frame = body_frame(joints)
+    vectors = np.full((T, P, 3), np.nan)
+    bend_deg = np.full((T, P), np.nan)
+    for p, part in enumerate(PART_SEGMENTS):
+        a, b = PART_SEGMENTS[part]
+        v = joints[:, joint_index(b)] - joints[:, joint_index(a)]
+        n = np.linalg.norm(v, axis=-1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            v = np.where(n > 1e-12, v / n, np.nan)
+        vectors[:, p] = np.einsum("tij,tj->ti", frame, v)
+        if part in PART_MIDDLE_JOINT:
+            m = PART_MIDDLE_JOINT[part]
+            bend_deg[:, p] = bend_angle(joints[:, joint_index(a)], joints[:, joint_index(m)], joints[:, joint_index(b)])
+    direction, level = classify_indices(vectors)
+    bend = np.where(np.isnan(bend_deg), -1, bend_degree(bend_deg))
+    supporting, sup_level = support_frames(joints, fps, floor)
+    g = len(PART_SEGMENTS)
+    for k, part in enumerate(("right_support", "left_support")):
+        c = g + SUPPORT_PARTS.index(part)
+        direction[:, c] = np.where(supporting[:, k], PLACE, -1)
+        level[:, c] = sup_level[:, k]
+    both = supporting.all(axis=1) & (sup_level[:, 0] == sup_level[:, 1])
+    c = g + SUPPORT_PARTS.index("support")
+    direction[:, c] = np.where(both, PLACE, -1)
+    level[:, c] = np.where(both, sup_level[:, 0], -1)
+    times = np.arange(T) / float(fps)
+    return FrameLabels(
+        times=times,
+        parts=LABEL_PARTS,
+        direction=direction.astype(int),
+        level=level.astype(int),
+        bend=bend.astype(int),
+        vectors=vectors,
+        bend_deg=bend_deg,
+        supporting=supporting,
+        support_level=sup_level,
+    )
+
+
+def labels_csv_text(labels: FrameLabels) -> str:
+    """The ``labels.csv`` text: one row per frame and part.
+
+    Columns ``frame, time, part, direction, level, bend``; undefined labels
+    are empty cells, ``bend`` is empty for parts that carry none.
+    """
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(("frame", "time", "part", "direction", "level", "bend"))
+    T, P = labels.direction.shape
+    dnames = np.array(DIRECTION_NAMES + ("",), dtype=object)
+    lnames = np.array(LEVELS + ("",), dtype=object)
+    # Index −1 picks the trailing empty name.
+    d = dnames[labels.direction]
+    lv = lnames[labels.level]
+    for t in range(T):
+        time = f"{labels.times[t]:.4f}"
+        for p in range(P):
+            b = labels.bend[t, p]
+            w.writerow((t, time, labels.parts[p], d[t, p], lv[t, p], "" if b < 0 else int(b)))
+    return buf.getvalue()
+
+
+def write_labels_csv(labels: FrameLabels, path) -> None:
+    """Atomically write :func:`labels_csv_text` to `path`."""
+    write_text(path, labels_csv_text(labels))

@@ -1,0 +1,355 @@
+"""The capture job: video or motion file → notation files a notator can use.
+
+INPUT is a video file or image folder (keypoints → 3D fit), or a motion file
+(BVH, Kinect v2 CSV, truth sidecar ``.npz``) read directly.  The motion is
+then quantised (:mod:`capture2notation.quantise`) and every output is
+written atomically into OUTDIR:
+
+==================  ==========================================================
+``score.lab``       the score, our text format
+``score.json``      the same, JSON
+``laban_editor.json``  LabanotationSuite's LabanEditor score
+``benesh.json``     Benesh key poses at every key frame
+``labels.csv``      per-frame labels of every part
+``staff.svg/.png``  the Labanotation staff
+``capture.npz``     keypoints (video input), fitted joints (T, J, 3), angles,
+                    confidence (T, J), fps, times
+``effort.json``     Laban Effort with uncertainty (and its plots)
+``overlay.mp4``     the video with the keypoints drawn (video input)
+``index.html``      the staff beside the overlay video
+==================  ==========================================================
+
+For a rendered video with its ``truth.npz`` beside it, the fit uses the
+sidecar's camera (known intrinsics and pose); otherwise the fitting stage's
+default camera refined from the data.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from capture2notation.body import JOINTS
+from capture2notation.errors import C2NError, PipelineError
+from capture2notation.io.atomic import atomic_path, write_text
+from capture2notation.notation.model import Score
+from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
+from capture2notation.quantise.labels import write_labels_csv
+from capture2notation.quantise.segment import SegmentParams, Segmentation, segment_motion
+
+__all__ = ["VIDEO_SUFFIXES", "MOTION_SUFFIXES", "CaptureResult", "input_kind", "capture", "load_motion"]
+
+log = logging.getLogger(__name__)
+
+VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm", ".mpg", ".mpeg")
+MOTION_SUFFIXES = (".bvh", ".csv", ".npz")
+_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+
+
+@dataclass(frozen=True, eq=False)
+class CaptureResult:
+    """What :func:`capture` produced.
+
+    Attributes
+    ----------
+    outdir : Path
+    kind : str
+        ``"video"``, ``"bvh"``, ``"kinect"`` or ``"truth"``.
+    score : Score
+    segmentation : Segmentation
+    motion : FitResult
+        Fitted (video) or read (motion file) joints, angles, confidence.
+    track : KeypointTrack or None
+        Keypoints (video input only).
+    files : dict of str to Path
+        Every file written, by name.
+    seconds : dict of str to float
+        Wall-clock time of each stage.
+    skipped : tuple of str
+        Outputs not written, with the reason.
+    """
+
+    outdir: Path
+    kind: str
+    score: Score
+    segmentation: Segmentation
+    motion: object
+    track: object | None
+    files: dict = field(default_factory=dict)
+    seconds: dict = field(default_factory=dict)
+    skipped: tuple = ()
+
+    @property
+    def n_frames(self) -> int:
+        return int(np.asarray(self.motion.joints).shape[0])
+
+
+def input_kind(path) -> str:
+    """Classify INPUT: ``video`` (file or image folder), ``bvh``, ``kinect`` or ``truth``.
+
+    Raises
+    ------
+    PipelineError
+        Missing path or unknown file type.
+    """
+    p = Path(path)
+    if p.is_dir():
+        if any(f.suffix.lower() in _IMAGE_SUFFIXES for f in p.iterdir()):
+            return "video"
+        raise PipelineError(f"{p}: folder holds no images ({', '.join(_IMAGE_SUFFIXES)}); expected an image sequence")
+    if not p.is_file():
+        raise PipelineError(f"{p}: no such file or folder")
+    ext = p.suffix.lower()
+    if ext in VIDEO_SUFFIXES:
+        return "video"
+    kinds = {".bvh": "bvh", ".csv": "kinect", ".npz": "truth"}
+    if ext in kinds:
+        return kinds[ext]
+    raise PipelineError(
+        f"{p}: unknown input type {ext!r}; expected a video ({' '.join(VIDEO_SUFFIXES)}), an image folder, "
+        "a .bvh, a Kinect .csv or a truth .npz"
+    )
+
+
+def _with_fps(motion, fps: float):
+    """`motion` re-timed at `fps` (frames unchanged)."""
+    T = np.asarray(motion.joints).shape[0]
+    return motion.replace(fps=float(fps), times=np.arange(T) / float(fps))
+
+
+def load_motion(path, kind: str, backend: str = "blazepose", fps_override=None, progress: bool = True):
+    """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
+
+    Returns
+    -------
+    motion : FitResult
+    track : KeypointTrack or None
+    seconds : dict
+        Time spent in ``keypoints`` and ``fitting`` (or ``read``).
+    """
+    seconds = {}
+    if kind == "video":
+        from capture2notation.fitting import Camera, fit_track
+        from capture2notation.keypoints import extract
+
+        t0 = time.perf_counter()
+        track = extract(path, backend=backend, fps=fps_override, progress=progress)
+        seconds["keypoints"] = time.perf_counter() - t0
+        camera = None
+        sidecar = Path(path).parent / "truth.npz" if Path(path).is_file() else Path(path) / "truth.npz"
+        if sidecar.is_file():
+            from capture2notation.io.truth import read_truth
+
+            camera = Camera.from_truth(read_truth(sidecar))
+            log.info("capture: using the camera of %s", sidecar)
+        t0 = time.perf_counter()
+        motion = fit_track(track, camera=camera)
+        seconds["fitting"] = time.perf_counter() - t0
+        return motion, track, seconds
+    from capture2notation.io.motion import read_motion
+
+    t0 = time.perf_counter()
+    motion = read_motion(path)
+    seconds["read"] = time.perf_counter() - t0
+    if fps_override is not None:
+        motion = _with_fps(motion, fps_override)
+    return motion, None, seconds
+
+
+def _check_options(backend: str, tempo, fps_override) -> None:
+    if backend not in ("blazepose", "markers"):
+        raise PipelineError(f"--backend {backend!r} is not one of blazepose, markers")
+    if tempo is not None and not (np.isfinite(float(tempo)) and 0 < float(tempo) <= 400):
+        raise PipelineError(f"--tempo {tempo!r} must be beats per minute in (0, 400]")
+    if fps_override is not None and not (np.isfinite(float(fps_override)) and 0 < float(fps_override) <= 1000):
+        raise PipelineError(f"--fps-override {fps_override!r} must be a frame rate in (0, 1000]")
+
+
+def capture(
+    input_path,
+    outdir,
+    backend: str = "blazepose",
+    tempo=None,
+    fps_override=None,
+    progress: bool = True,
+    *,
+    meter: int = 4,
+    params: SegmentParams | None = None,
+    effort: bool = True,
+    seed: int = 0,
+    overlay: bool = True,
+) -> CaptureResult:
+    """Capture notation from a video or motion file.
+
+    Parameters
+    ----------
+    input_path : str or Path
+        Video file, image folder, ``.bvh``, Kinect ``.csv`` or truth ``.npz``.
+    outdir : str or Path
+        Created if missing; see the module docstring for its files.
+    backend : {"blazepose", "markers"}
+        Keypoint backend for video input.
+    tempo : float, optional
+        Beats per minute; estimated from the key frames when omitted.
+    fps_override : float, optional
+        Frame rate to use instead of the file's.
+    progress : bool
+        Progress bar over frames (stderr).
+    meter : int
+        Beats per measure of the written score.
+    params : SegmentParams, optional
+        Segmentation tuning (beat grid, smoothing, thresholds).
+    effort : bool
+        Estimate Laban Effort (``effort.json``); the slowest step.
+    seed : int
+        Seed of the Effort posteriors.
+    overlay : bool
+        Write ``overlay.mp4`` for video input.
+
+    Returns
+    -------
+    CaptureResult
+    """
+    _check_options(backend, tempo, fps_override)
+    kind = input_kind(input_path)
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress)
+    joints = np.asarray(motion.joints, dtype=float)
+    fps = float(motion.fps)
+    if not np.isfinite(joints).any():
+        raise PipelineError(f"{input_path}: no frame could be measured (no person found?)")
+
+    t0 = time.perf_counter()
+    title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
+    seg = segment_motion(joints, fps, tempo=tempo, meter=meter, params=params, title=title)
+    seconds["quantise"] = time.perf_counter() - t0
+    if seg.tempo_estimated:
+        log.info("capture: estimated tempo %s bpm", seg.tempo)
+    files, skipped = _write_outputs(outdir, seg, motion, track, input_path, kind, overlay)
+    if effort:
+        t0 = time.perf_counter()
+        try:
+            files.update(_write_effort(outdir, seg.score, motion, seed))
+        except C2NError as exc:
+            # Effort is an addition to the notation: report, keep the rest.
+            skipped.append(f"effort.json: {exc}")
+            log.warning("capture: effort not estimated: %s", exc)
+        seconds["effort"] = time.perf_counter() - t0
+    result = CaptureResult(outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped))
+    files["index.html"] = write_text(outdir / "index.html", index_html(result))
+    return result
+
+
+def _write_outputs(outdir: Path, seg: Segmentation, motion, track, input_path, kind: str, overlay: bool):
+    from capture2notation.notation import write
+    from capture2notation.notation.formats.laban_editor import write_laban_editor
+    from capture2notation.notation.staff import render_staff
+
+    files: dict = {}
+    skipped: list = []
+    score = seg.score
+    files["score.lab"] = write(score, outdir / "score.lab")
+    files["score.json"] = write(score, outdir / "score.json")
+    files["laban_editor.json"] = write_laban_editor(score, outdir / "laban_editor.json")
+    angles = getattr(motion, "angles", None)
+    stave, poses = benesh_key_poses(
+        motion.joints, seg.key_frames, motion.fps, tempo=score.tempo, angles=angles
+    )
+    write_benesh(outdir / "benesh.json", stave, poses, tempo=score.tempo)
+    files["benesh.json"] = outdir / "benesh.json"
+    write_labels_csv(seg.labels, outdir / "labels.csv")
+    files["labels.csv"] = outdir / "labels.csv"
+    files["staff.svg"] = render_staff(score, outdir / "staff.svg", outdir / "staff.png")
+    files["staff.png"] = outdir / "staff.png"
+    files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track)
+    if kind == "video" and overlay and track is not None:
+        from capture2notation.keypoints.overlay import write_overlay
+
+        files["overlay.mp4"] = write_overlay(input_path, track, outdir / "overlay.mp4", fps=track.fps)
+    elif kind != "video":
+        skipped.append("overlay.mp4: no video (motion file input)")
+    return files, skipped
+
+
+def _write_npz(path: Path, motion, track) -> Path:
+    T = np.asarray(motion.joints).shape[0]
+    arrays = {
+        "fps": np.asarray(float(motion.fps)),
+        "times": np.asarray(motion.times, float),
+        "joint_names": np.asarray(JOINTS),
+        "joints": np.asarray(motion.joints, float),
+        "angles": np.asarray(motion.angles, float),
+        "root": np.asarray(motion.root, float),
+        "confidence": np.asarray(motion.confidence, float),
+    }
+    if track is not None:
+        arrays["keypoints"] = np.asarray(track.xy, float)
+        arrays["visibility"] = np.asarray(track.visibility, float)
+        arrays["image_size"] = np.asarray(track.image_size)
+    else:
+        arrays["keypoints"] = np.full((T, 33, 3), np.nan)
+        arrays["visibility"] = np.zeros((T, 33))
+    with atomic_path(path, suffix=".npz") as tmp:
+        np.savez_compressed(tmp, **arrays)
+    return path
+
+
+def _write_effort(outdir: Path, score: Score, motion, seed: int) -> dict:
+    from capture2notation.effort import estimate_effort, write_effort
+
+    result = estimate_effort(
+        motion.joints, motion.confidence, motion.fps, score, rng=np.random.default_rng(seed), times=motion.times
+    )
+    paths = write_effort(result, outdir, plots=True, rng=seed)
+    return {Path(p).name: Path(p) for p in paths.values()}
+
+
+def index_html(result: CaptureResult) -> str:
+    """A self-contained page: the staff beside the overlay video, the symbols and the files."""
+    score = result.score
+    rows = "\n".join(
+        f"<tr><td>{s.start}</td><td>{s.duration}</td><td>{html.escape(s.part)}</td>"
+        f"<td>{html.escape(s.direction)}</td><td>{html.escape(s.level)}</td><td>{s.bend or ''}</td></tr>"
+        for s in score.symbols
+    )
+    video = (
+        '<video src="overlay.mp4" controls loop muted playsinline width="100%"></video>'
+        if "overlay.mp4" in result.files
+        else "<p>No video: the input was a motion file.</p>"
+    )
+    links = " · ".join(f'<a href="{html.escape(n)}">{html.escape(n)}</a>' for n in sorted(result.files) if n != "index.html")
+    tempo = f"{score.tempo} bpm" + (" (estimated)" if result.segmentation.tempo_estimated else "")
+    skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
+    timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
+    return f"""<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>Capture: {html.escape(score.title)}</title>
+<style>
+body {{ font-family: sans-serif; margin: 1.5em; }}
+.row {{ display: flex; gap: 2em; align-items: flex-start; }}
+.staff {{ flex: 0 0 auto; max-height: 90vh; overflow-y: auto; }}
+.video {{ flex: 1 1 480px; max-width: 720px; }}
+table {{ border-collapse: collapse; }} td, th {{ padding: 0.1em 0.6em; border-bottom: 1px solid #ddd; }}
+</style></head><body>
+<h1>Capture: {html.escape(score.title)}</h1>
+<p>{result.n_frames} frames at {float(result.motion.fps):g} fps · input: {html.escape(result.kind)} ·
+tempo {html.escape(tempo)} · meter {score.meter} · {len(score.symbols)} symbols</p>
+<div class="row">
+<div class="staff"><img src="staff.svg" alt="Labanotation staff of the captured score"></div>
+<div class="video">{video}
+<h2>Symbols</h2>
+<table><tr><th>start</th><th>duration</th><th>part</th><th>direction</th><th>level</th><th>bend</th></tr>
+{rows}
+</table></div></div>
+<h2>Files</h2><p>{links}</p>
+{"<h2>Not written</h2><ul>" + skipped + "</ul>" if skipped else ""}
+<p>Time: {html.escape(timing)}</p>
+<script type="application/json" id="summary">{html.escape(json.dumps({"tempo": str(score.tempo), "symbols": len(score.symbols)}))}</script>
+</body></html>
+"""

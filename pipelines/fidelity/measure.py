@@ -1,0 +1,348 @@
+"""Record one performance under one condition, capture it, and measure the result.
+
+Capture paths (``capture`` in the study config):
+
+``truth``
+    The virtual dancer's own joints, projected into the condition's camera,
+    jittered by the condition's pixel noise plus a 1 px detector floor,
+    rounded to the pixel grid, and lifted back to 3D with the true depth.
+    Cheapest; it isolates frame rate, image resolution and viewpoint
+    geometry.  Compression is not modelled (no image).
+``keypoints``
+    The 33 BlazePose landmarks of the virtual dancer, projected into the
+    condition's camera with the renderer's self-occlusion test (hidden
+    landmarks are missing), jittered and rounded as above, then fitted in 3D
+    by :func:`capture2notation.fitting.fit_keypoints` with the known camera
+    and default body proportions.  Compression is not modelled.
+``video``
+    Not wired in this version (see the report's notes): it needs the
+    renderer and the capture pipeline on every job.
+
+Only the kept frames of a condition reach the capture (the others are
+missing, never invented); the metrics that need a full-rate sequence use the
+captured frames linearly interpolated in time, as a capture system that
+resamples to a uniform rate would.
+"""
+
+from __future__ import annotations
+
+import logging
+from fractions import Fraction
+
+import numpy as np
+
+from capture2notation.compare.align import align_dtw
+from capture2notation.compare.metrics import compare_movements, key_frames, mpjpe, notation_agreement, pa_mpjpe
+from capture2notation.compare.resample import decimate, keyframe_resample
+from capture2notation.errors import C2NError, PipelineError
+from capture2notation.notation.model import PART_SEGMENTS, Score
+
+from .conditions import Condition, Performance, take_variation
+
+__all__ = ["DETECTOR_FLOOR_PX", "perform", "kept_frames", "capture", "interpolate_missing", "measure", "estimate_effort"]
+
+log = logging.getLogger(__name__)
+
+#: Keypoint jitter (px) that even a clean, full-resolution image leaves: our
+#: stated assumption for the truth and keypoint paths.
+DETECTOR_FLOOR_PX = 1.0
+
+
+def builtin_scores() -> dict[str, Score]:
+    """Built-in phrases of the virtual dancer, name → Score."""
+    try:
+        from synthetic.phrases import builtin_phrases
+    except ImportError as exc:
+        raise PipelineError(f"the virtual dancer's phrases are not available ({exc})") from None
+    phrases = builtin_phrases()
+    if isinstance(phrases, dict):
+        return dict(phrases)
+    return {getattr(p, "name", None) or p.title: getattr(p, "score", p) for p in phrases}
+
+
+def perform(perf: Performance, seed: int, fps: float, scores: dict | None = None):
+    """The virtual dancer performs one take.
+
+    Returns
+    -------
+    score : Score
+        The phrase as danced: the take's tempo and Effort.
+    motion : synthetic.motion.Motion
+    """
+    from capture2notation.body import Body
+    from synthetic.interpret import interpret
+
+    scores = scores if scores is not None else builtin_scores()
+    if perf.phrase not in scores:
+        raise PipelineError(f"unknown phrase {perf.phrase!r}; built-in phrases are {', '.join(sorted(scores))}")
+    var = take_variation(perf, seed)
+    score = scores[perf.phrase].replace(tempo=var["tempo"], effort=var["effort"], emotion=None)
+    body = Body(height=var["height"])
+    motion = interpret(score, fps=fps, body=body)
+    return score, motion
+
+
+def kept_frames(cond: Condition, score: Score, n_frames: int, fps: float) -> np.ndarray:
+    """Frames the condition's frame rate keeps (key poses = symbol arrivals)."""
+    if cond.resampling == "naive":
+        return decimate(n_frames, cond.rate, Fraction(str(fps)))
+    kf = key_frames(score, fps, n_frames)
+    return keyframe_resample(n_frames, kf, cond.rate, Fraction(str(fps)))
+
+
+def _camera(cond: Condition, height: float):
+    from synthetic.render.camera import Camera
+
+    return Camera.for_view(cond.view, size=(cond.width, cond.height), body_height=height)
+
+
+def _jitter(uv: np.ndarray, cond: Condition, rng: np.random.Generator) -> np.ndarray:
+    sigma = float(np.hypot(DETECTOR_FLOOR_PX, cond.noise))
+    noisy = uv + rng.normal(0.0, sigma, size=uv.shape)
+    return np.floor(noisy) + 0.5  # a detector reports pixel centres
+
+
+def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random.Generator):
+    """Capture the kept frames of a performance.
+
+    Parameters
+    ----------
+    mode : {"truth", "keypoints"}
+    motion : synthetic.motion.Motion
+    kept : (M,) ndarray of int
+    cond : Condition
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    joints : (T, J, 3) ndarray
+        World joints at the kept frames, NaN elsewhere.
+    confidence : (T, J) ndarray
+        In [0, 1], 0 where missing.
+    """
+    truth = motion.joints()
+    T, J, _ = truth.shape
+    out = np.full((T, J, 3), np.nan)
+    conf = np.zeros((T, J))
+    cam = _camera(cond, motion.body.height)
+    if mode == "truth":
+        p = truth[kept]
+        uv, depth = cam.project(p, return_depth=True)
+        uv = _jitter(uv, cond, rng)
+        k = cam.K
+        xc = np.stack([(uv[..., 0] - k[0, 2]) / k[0, 0] * depth, (uv[..., 1] - k[1, 2]) / k[1, 1] * depth, depth], -1)
+        out[kept] = (xc - cam.t) @ cam.R  # R^T (x_cam − t), row vectors
+        conf[kept] = cam.in_image(uv).astype(float)
+        out[conf == 0] = np.nan
+        return out, conf
+    if mode == "keypoints":
+        from capture2notation.fitting import fit_keypoints
+        from capture2notation.fitting.camera import Camera as FitCamera
+        from synthetic.render.scene import Pose, landmark_visibility
+
+        pose = Pose.from_motion(motion)
+        lm = pose.landmarks[kept]
+        vis = landmark_visibility(pose, cam)[kept]
+        uv = _jitter(cam.project(lm), cond, rng)
+        uv[vis == 0] = np.nan
+        fitcam = FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height))
+        res = fit_keypoints(uv, vis, motion.fps, camera=fitcam, times=kept / motion.fps)
+        out[kept] = res.joints
+        conf[kept] = res.confidence
+        out[conf == 0] = np.nan
+        return out, conf
+    raise PipelineError(f"capture path {mode!r} is not available; use 'truth' or 'keypoints'")
+
+
+def interpolate_missing(joints: np.ndarray) -> np.ndarray:
+    """Fill NaN frames by linear interpolation in time (ends held), per joint.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+
+    Returns
+    -------
+    (T, J, 3) ndarray
+        Joints never seen at all stay NaN.
+    """
+    x = np.asarray(joints, dtype=float)
+    T = x.shape[0]
+    flat = x.reshape(T, -1)
+    out = flat.copy()
+    t = np.arange(T)
+    ok = np.isfinite(flat)
+    for c in np.flatnonzero(ok.any(0) & ~ok.all(0)):  # only columns with gaps
+        out[:, c] = np.interp(t, t[ok[:, c]], flat[ok[:, c], c])
+    return out.reshape(x.shape)
+
+
+def estimate_effort(joints, confidence, fps: float, score: Score, kept: np.ndarray, rng, bootstrap: int) -> dict:
+    """Pooled Effort of a captured phrase from its kept frames, with bootstrap intervals.
+
+    Each gesture symbol's window gives a progress curve
+    (:func:`capture2notation.effort.curves.progress_curve`); the curves are
+    pooled and fitted by least squares (time b, weight x0) and the Space
+    model; the 90 % intervals come from resampling the movements.
+
+    Returns
+    -------
+    dict
+        ``time``, ``weight``, ``space`` → (estimate, lo, hi) and
+        ``movements`` (curves used); NaN when fewer than 2 curves survive.
+    """
+    from scipy import optimize
+
+    from capture2notation.effort import TIME_RANGE, WEIGHT_RANGE, progress
+    from capture2notation.effort.curves import progress_curve
+    from capture2notation.effort.fit import fit_logistic, fit_space
+
+    times = kept / fps
+    curves = []
+    for s in score.symbols:
+        if s.part not in PART_SEGMENTS:
+            continue
+        try:
+            c = progress_curve(joints[kept], confidence[kept], times, s.part, score.seconds(s.start), score.seconds(s.end))
+        except C2NError:
+            continue  # too few frames inside this movement at this frame rate
+        if c is not None:
+            curves.append(c)
+    nan3 = (np.nan, np.nan, np.nan)
+    if len(curves) < 2:
+        return {"time": nan3, "weight": nan3, "space": nan3, "movements": len(curves)}
+
+    def pooled(sel):
+        return tuple(np.concatenate([getattr(curves[i], k) for i in sel]) for k in ("tau", "s", "weight", "radial"))
+
+    tau, s, w, rad = pooled(np.arange(len(curves)))
+    lf = fit_logistic(tau, s, w)
+    est = (lf.b, lf.x0, fit_space(tau, rad, w).median)
+    boots = []
+    for _ in range(bootstrap):
+        sel = rng.integers(0, len(curves), len(curves))
+        tau, s, w, rad = pooled(sel)
+        # One warm start from the full fit: resamples stay near it, and the
+        # multi-start search of fit_logistic would cost 4x as much.
+        r = optimize.least_squares(
+            lambda p: np.sqrt(w) * (progress(tau, p[0], p[1]) - s), [lf.b, lf.x0],
+            bounds=([TIME_RANGE[0], WEIGHT_RANGE[0]], [TIME_RANGE[1], WEIGHT_RANGE[1]]), x_scale=[1.0, 0.1],
+        )
+        boots.append((r.x[0], r.x[1], fit_space(tau, rad, w).median))
+    boots = np.array(boots, dtype=float).reshape(-1, 3)
+    lo = np.quantile(boots, 0.05, axis=0) if bootstrap else np.array(est)
+    hi = np.quantile(boots, 0.95, axis=0) if bootstrap else np.array(est)
+    est = tuple(float(x) for x in est)
+    lo, hi = lo.astype(float), hi.astype(float)
+    return {
+        "time": (est[0], float(min(lo[0], est[0])), float(max(hi[0], est[0]))),
+        "weight": (est[1], float(min(lo[1], est[1])), float(max(hi[1], est[1]))),
+        "space": (est[2], float(min(lo[2], est[2])), float(max(hi[2], est[2]))),
+        "movements": len(curves),
+    }
+
+
+def measure(score: Score, motion, joints, confidence, kept, rng, bootstrap: int) -> dict:
+    """Every metric of one captured job against the virtual dancer's truth.
+
+    Returns
+    -------
+    dict
+        Flat numbers for ``results.csv`` (see the report for their meaning).
+    """
+    fps = motion.fps
+    truth = motion.joints()
+    rec = interpolate_missing(joints)
+    T = len(truth)
+    kf = key_frames(score, fps, T)
+    row: dict = {"frames": T, "kept_frames": int(len(kept))}
+    usable = np.all(np.isfinite(rec[:, :, 0]), axis=0)
+    if not usable.any():
+        raise PipelineError("the capture recovered no joint at all")
+    filled = _fill_unseen(rec)
+    al = align_dtw(truth, filled, band=int(round(fps)))
+    moves = compare_movements(score, truth, rec, kf, al.candidate_frame(kf), fps, fps)
+    gest = [m for m in moves if m.verdict != "n/a"]
+    row["symbols"] = len(gest)
+    row["symbol_accuracy"] = float(np.mean([m.agree for m in gest])) if gest else np.nan
+    row["angle_error_deg"] = float(np.nanmean([m.pose_error for m in gest])) if gest else np.nan
+    row["timing_error_s"] = float(np.mean([abs(m.timing_offset) for m in gest])) if gest else np.nan
+    row["mpjpe_mm"] = 1000.0 * float(np.nanmean(mpjpe(truth, rec)))
+    row["pa_mpjpe_mm"] = 1000.0 * float(np.nanmean(pa_mpjpe(truth, rec)))
+    try:
+        from capture2notation.quantise.segment import segment_motion
+
+        seg = segment_motion(filled, fps)
+        na = notation_agreement(score, seg.score)
+        row["notation_accuracy"] = na["fraction"]
+        row["notation_extra"] = na["extra"]
+        row["tempo_est"] = float(seg.tempo)
+    except C2NError as exc:
+        log.info("segmentation failed: %s", exc)
+        row["notation_accuracy"] = np.nan
+        row["notation_extra"] = np.nan
+        row["tempo_est"] = np.nan
+    row["tempo_obs"] = observed_tempo(rec, fps, score)
+    eff = estimate_effort(joints, confidence, fps, score, kept, rng, bootstrap)
+    truth_eff = score.resolved_effort()
+    row["effort_movements"] = eff["movements"]
+    for name in ("time", "weight", "space"):
+        est, lo, hi = eff[name]
+        true = getattr(truth_eff, name)
+        row[f"{name}_est"] = est
+        row[f"{name}_lo"] = lo
+        row[f"{name}_hi"] = hi
+        row[f"{name}_true"] = true
+        row[f"{name}_error"] = est - true
+        row[f"{name}_covered"] = float(lo <= true <= hi) if np.isfinite(lo) else np.nan
+    row["tempo_true"] = float(score.tempo)
+    return row
+
+
+def observed_tempo(joints: np.ndarray, fps: float, score: Score, rel: float = 0.15) -> float:
+    """Tempo (bpm) from how long the dancer takes over the phrase's gestures.
+
+    The exercise is known to the observer (as in Neagle's trials: both
+    performances of a trial dance the same exercise), so its gestures span
+    a known number of beats; the time from the first to the last frame in
+    which some limb turns faster than `rel` of the take's peak angular speed
+    gives the tempo.  NaN when no movement is seen.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        Captured joints at the full rate (gaps interpolated).
+    fps : float
+    score : Score
+        The exercise (only its beats are used, never its tempo).
+    rel : float
+        Activity threshold as a fraction of the peak speed.
+    """
+    from capture2notation.compare.align import limb_features
+    from capture2notation.compare.metrics import angle_between
+
+    gest = [s for s in score.symbols if s.part in PART_SEGMENTS]
+    if not gest or len(joints) < 3:
+        return float("nan")
+    beats = float(max(s.end for s in gest) - min(s.start for s in gest))
+    f = limb_features(_fill_unseen(joints))
+    speed = np.nan_to_num(angle_between(f[1:], f[:-1])).max(axis=1) * fps  # (T-1,) deg/s
+    if speed.max() <= 0:
+        return float("nan")
+    active = np.flatnonzero(speed > rel * speed.max())
+    span = (active[-1] + 1 - active[0]) / fps
+    return 60.0 * beats / span if span > 0 else float("nan")
+
+
+def _fill_unseen(rec: np.ndarray) -> np.ndarray:
+    """Put joints never seen in the whole take on the pelvis.
+
+    Limbs ending at such a joint then have zero length, which the alignment
+    features treat as undefined, instead of NaN poisoning whole frames.
+    Used only as alignment and segmentation input, never as a measurement.
+    """
+    out = rec.copy()
+    bad = ~np.all(np.isfinite(out), axis=(0, 2))
+    if bad.any():
+        out[:, bad] = out[:, :1]
+    return out

@@ -1,0 +1,336 @@
+"""Run a fidelity study: every job in parallel, cached, then the same/different trials.
+
+Jobs run on local processes by default (one per core, with a progress bar)
+or on a Dask distributed cluster (``scheduler`` address).  Each finished job
+is cached as ``cache/<hash>.json`` in the output folder, the hash covering
+the job's whole configuration and the code version, so an interrupted study
+resumes where it stopped.  Every random draw is seeded from the study seed
+and the job's identity (not its position in a queue), so the same seed gives
+the same ``results.csv`` however the jobs are scheduled.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import logging
+import math
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+from capture2notation import __version__
+from capture2notation.compare.discrimination import (
+    SameDifferentObserver,
+    experiment1_trials,
+    experiment2_trials,
+    feature_vector,
+    run_trials,
+    summarise,
+)
+from capture2notation.errors import C2NError, PipelineError
+from capture2notation.io.atomic import write_text
+
+from .conditions import Condition, Job, build_conditions, build_jobs, phrase_complexity, stable_seed
+from .config import StudyConfig
+from .measure import builtin_scores, capture, kept_frames, measure, perform
+
+__all__ = ["STUDY_VERSION", "resolve_capture", "run_condition", "run_study", "StudyResult"]
+
+log = logging.getLogger(__name__)
+
+#: Bumped when the measurement changes, so cached jobs are recomputed.
+STUDY_VERSION = f"{__version__}-fidelity-1"
+
+#: Capture paths without images (compression cannot be applied).
+IMAGE_FREE = ("truth", "keypoints")
+
+#: Columns of results.csv, in order (one row per job).
+ID_COLUMNS = (
+    "factor", "frame_rate", "resampling", "width", "height", "view", "compression", "noise",
+    "phrase", "complexity", "emotion", "take", "split", "capture",
+)
+
+
+def resolve_capture(mode: str) -> str:
+    """The capture path to use: ``auto`` picks ``keypoints`` when the fitter and renderer geometry exist."""
+    if mode != "auto":
+        return mode
+    try:
+        import capture2notation.fitting  # noqa: F401
+        import synthetic.render.scene  # noqa: F401
+        from capture2notation.fitting import fit_keypoints  # noqa: F401
+    except ImportError:
+        return "truth"
+    return "keypoints"
+
+
+def run_condition(job: Job, seed: int, capture_mode="truth", fps: float = 25.0, bootstrap: int = 30, scores=None) -> dict:
+    """Perform, record, capture and measure one job.
+
+    Parameters
+    ----------
+    job : Job
+        A performance under a condition.
+    seed : int
+        Study seed.
+    capture_mode : str or callable
+        ``"truth"``, ``"keypoints"``, or a function ``(motion, kept, condition,
+        rng) -> (joints (T,J,3), confidence (T,J))`` (the pluggable capture).
+    fps : float
+        The virtual dancer's frame rate.
+    bootstrap : int
+        Resamples for the Effort intervals.
+    scores : dict, optional
+        Phrase name → Score (default: the built-in phrases).
+
+    Returns
+    -------
+    dict
+        The job's identity columns and its metrics; ``error`` is the message
+        of a failure (metrics then absent), never a silent default.
+    """
+    c, p = job.condition, job.performance
+    row = {k: v for k, v in asdict(c).items()} | asdict(p)
+    row["capture"] = capture_mode if isinstance(capture_mode, str) else getattr(capture_mode, "__name__", "custom")
+    rng = np.random.default_rng(stable_seed("job", seed, *c.params(), *asdict(p).values()))
+    t0 = time.perf_counter()
+    try:
+        score, motion = perform(p, seed, fps, scores)
+        kept = kept_frames(c, score, motion.n_frames, motion.fps)
+        if callable(capture_mode):
+            joints, conf = capture_mode(motion, kept, c, rng)
+        else:
+            joints, conf = capture(capture_mode, motion, kept, c, rng)
+        row.update(measure(score, motion, joints, conf, kept, rng, bootstrap))
+        row["error"] = ""
+    except C2NError as exc:
+        row["error"] = f"{type(exc).__name__}: {exc}"
+    row["seconds"] = time.perf_counter() - t0
+    return row
+
+
+def _job_worker(args):
+    job, seed, mode, fps, bootstrap = args
+    return run_condition(job, seed, mode, fps, bootstrap)
+
+
+class StudyResult:
+    """Rows of a finished study and its discrimination summary."""
+
+    def __init__(self, rows, trials, summary, conditions, wall_seconds):
+        self.rows = rows
+        self.trials = trials
+        self.summary = summary
+        self.conditions = conditions
+        self.wall_seconds = wall_seconds
+
+
+def _cache_path(outdir: Path, job: Job, cfg: StudyConfig, mode: str) -> Path:
+    return outdir / "cache" / f"{job.digest(cfg, mode, STUDY_VERSION)}.json"
+
+
+def _execute(pending, cfg, mode, scheduler, workers, progress):
+    """Yield (job, row) as jobs finish, locally or on a Dask cluster."""
+    from tqdm import tqdm
+
+    args = [(j, cfg.seed, mode, cfg.source_fps, cfg.bootstrap) for j in pending]
+    bar = tqdm(total=len(args), desc="fidelity study", unit="job", disable=not progress)
+    try:
+        if scheduler:
+            from dask.distributed import Client
+            from dask.distributed import as_completed as dask_completed
+
+            try:
+                client = Client(scheduler, timeout="20s")
+            except (OSError, TimeoutError) as exc:
+                raise PipelineError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}") from None
+            try:
+                futures = client.map(_job_worker, args, pure=False)
+                index = {f.key: i for i, f in enumerate(futures)}
+                for fut in dask_completed(futures):
+                    yield pending[index[fut.key]], fut.result()
+                    bar.update()
+            finally:
+                client.close()
+        elif workers == 1 or len(args) <= 1:
+            for j, a in zip(pending, args):
+                yield j, _job_worker(a)
+                bar.update()
+        else:
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                futs = {pool.submit(_job_worker, a): j for j, a in zip(pending, args)}
+                for fut in as_completed(futs):
+                    yield futs[fut], fut.result()
+                    bar.update()
+    finally:
+        bar.close()
+
+
+def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: int | None = None,
+              progress: bool = True) -> StudyResult:
+    """Run (or resume) a study and write ``results.csv``, ``trials.csv`` and ``summary.json``.
+
+    Parameters
+    ----------
+    cfg : StudyConfig
+    outdir : str or Path
+    scheduler : str, optional
+        Dask scheduler address (``tcp://host:8786``); local processes otherwise.
+    workers : int, optional
+        Local processes (default: the number of cores).
+    progress : bool
+        Show a tqdm progress bar.
+    """
+    t0 = time.perf_counter()
+    outdir = Path(outdir)
+    mode = resolve_capture(cfg.capture)
+    scores = builtin_scores()
+    names = tuple(cfg.phrases) or tuple(sorted(scores))
+    missing = [n for n in names if n not in scores]
+    if missing:
+        raise PipelineError(f"unknown phrase(s) {', '.join(missing)}; built-in phrases are {', '.join(sorted(scores))}")
+    complexity = phrase_complexity({n: scores[n] for n in (tuple(sorted(scores)))})
+    conditions = build_conditions(cfg)
+    if mode in IMAGE_FREE:
+        # No image on these paths: a compression level would silently equal the baseline.
+        conditions = [c for c in conditions if c.compression == 0]
+    jobs = build_jobs(cfg, names, complexity, conditions)
+    rows_by_job: dict = {}
+    pending = []
+    for j in jobs:
+        path = _cache_path(outdir, j, cfg, mode)
+        if path.exists():
+            try:
+                rows_by_job[j] = json.loads(path.read_text(encoding="utf-8"))
+                continue
+            except (OSError, json.JSONDecodeError):
+                log.warning("ignoring unreadable cache file %s", path)
+        pending.append(j)
+    log.info("%d jobs, %d cached, %d to run (capture=%s)", len(jobs), len(jobs) - len(pending), len(pending), mode)
+    workers = workers or os.cpu_count() or 1
+    for j, row in _execute(pending, cfg, mode, scheduler, workers, progress):
+        write_text(_cache_path(outdir, j, cfg, mode), json.dumps(row, sort_keys=True, default=_json_default))
+        rows_by_job[j] = row
+    # Condition identity (not its factor label) keys the cache; restore the label here.
+    rows = []
+    for j in jobs:
+        r = dict(rows_by_job[j])
+        r["factor"] = j.condition.factor
+        rows.append(r)
+    trials, summary = discrimination(rows, cfg, conditions)
+    write_text(outdir / "results.csv", rows_to_csv(rows))
+    write_text(outdir / "trials.csv", rows_to_csv(trials))
+    wall = time.perf_counter() - t0
+    summary["config"] = cfg.as_dict()
+    summary["capture"] = mode
+    summary["jobs"] = {"total": len(jobs), "ran": len(pending), "cached": len(jobs) - len(pending),
+                       "failed": sum(1 for r in rows if r.get("error"))}
+    write_text(outdir / "summary.json", json.dumps(summary, indent=2, sort_keys=True, default=_json_default))
+    return StudyResult(rows, trials, summary, conditions, wall)
+
+
+def _json_default(o):
+    if isinstance(o, Fraction):
+        return str(o)
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.floating,)):
+        return float(o)
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def _fmt(v) -> str:
+    if isinstance(v, bool):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return "nan" if math.isnan(v) else f"{float(v):.6g}"
+    return str(v)
+
+
+def rows_to_csv(rows: list[dict]) -> str:
+    """CSV text with a stable column order (identity columns first, then sorted)."""
+    if not rows:
+        return ""
+    cols = [c for c in ID_COLUMNS if any(c in r for r in rows)]
+    rest = sorted({k for r in rows for k in r} - set(cols) - {"seconds"})
+    cols += rest
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(cols)
+    for r in rows:
+        w.writerow([_fmt(r.get(c, "")) for c in cols])
+    return buf.getvalue()
+
+
+def _features(r: dict) -> np.ndarray:
+    return feature_vector({"time": r.get("time_est"), "weight": r.get("weight_est"),
+                           "space": r.get("space_est"), "tempo": r.get("tempo_obs")})
+
+
+def discrimination(rows: list[dict], cfg: StudyConfig, conditions: list[Condition]) -> tuple[list, dict]:
+    """Same/different trials per condition (Experiment 1) and over frame rates (Experiment 2).
+
+    The observer is calibrated once, on the training takes recorded under
+    the baseline condition; the trials draw only test takes.
+    """
+    train = [r for r in rows if r["split"] == "train" and not r.get("error")]
+    if len(train) < 4:
+        raise PipelineError(f"only {len(train)} training performances succeeded; need >= 4 to calibrate the observer")
+    obs = SameDifferentObserver.calibrate(np.array([_features(r) for r in train]), [r["emotion"] for r in train])
+    test = [r for r in rows if r["split"] == "test" and not r.get("error")]
+    by_cond: dict = {}
+    for r in test:
+        params = (r["frame_rate"], r["resampling"], r["width"], r["height"], r["view"], r["compression"], r["noise"])
+        key = (r["emotion"], r["complexity"], Fraction(r["frame_rate"]))
+        by_cond.setdefault(params, {}).setdefault(key, []).append(_features(r))
+    complexities = tuple(c for c in ("easy", "medium", "hard") if any(r["complexity"] == c for r in test))
+    all_trials, per_condition = [], []
+    for c in conditions:
+        pool = {k: np.array(v) for k, v in by_cond.get(c.params(), {}).items()}
+        comps = tuple(x for x in complexities if all((e, x, c.rate) in pool and len(pool[(e, x, c.rate)]) >= 2
+                                                      for e in cfg.emotions))
+        if not comps:
+            continue
+        trials = experiment1_trials(comps, cfg.emotions, c.rate)
+        res = run_trials(trials, pool, obs, np.random.default_rng(stable_seed("trials", cfg.seed, *c.params())))
+        for t in res:
+            t.update({"experiment": 1, "condition": c.label, "factor": c.factor, "resampling": c.resampling})
+        all_trials += res
+        s = summarise(res)
+        per_condition.append({"condition": c.label, "factor": c.factor, **{k: v for k, v in asdict(c).items()},
+                              "percent_correct": s["overall"], "by_pair": s["by_pair"],
+                              "by_complexity": s["by_complexity"], "by_kind": s["by_kind"], "n": s["n"]})
+    exp2 = {}
+    emos2 = tuple(e for e in ("happy", "sad", "angry") if e in cfg.emotions)
+    comps2 = tuple(x for x in ("easy", "hard") if x in complexities) or complexities[:1]
+    base = conditions[0]
+    for method in cfg.resampling:
+        pool, rates = {}, []
+        for c in conditions:
+            if c.factor not in ("baseline", "frame_rate") or c.params()[2:] != base.params()[2:]:
+                continue
+            if c.resampling != method and c.rate != Fraction(str(cfg.source_fps)):
+                continue
+            pool.update({k: np.array(v) for k, v in by_cond.get(c.params(), {}).items()})
+            rates.append(c.rate)
+        rates = sorted(set(rates))
+        if len(emos2) < 2 or not rates or not comps2:
+            continue
+        trials = experiment2_trials(comps2, rates, emos2)
+        if not all((t.emotion_a, t.complexity, t.frame_rate) in pool for t in trials):
+            continue
+        res = run_trials(trials, pool, obs, np.random.default_rng(stable_seed("exp2", cfg.seed, method)))
+        for t in res:
+            t.update({"experiment": 2, "condition": f"frame rates, {method}", "factor": "frame_rate",
+                      "resampling": method})
+        all_trials += res
+        exp2[method] = summarise(res)
+    summary = {"observer": obs.as_dict(), "experiment1": per_condition, "experiment2": exp2}
+    return all_trials, summary

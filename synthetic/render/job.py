@@ -1,0 +1,174 @@
+"""Render a score or a motion to a folder: video, truth sidecar and the score.
+
+``render_score(score, outdir)`` writes ``OUTDIR/video.mp4``,
+``OUTDIR/truth.npz`` and ``OUTDIR/score.lab``; each file is written
+atomically.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from capture2notation.body import JOINTS, Body
+from capture2notation.errors import SyntheticError
+from capture2notation.io.truth import write_truth
+
+from .camera import VIEWS, Camera
+from .mannequin import Mannequin
+from .markers import Markers
+from .scene import Pose, landmark_visibility
+from .stick import Stick
+from .video import open_writer
+
+__all__ = ["STYLES", "make_renderer", "render_frames", "render_motion", "render_pose", "render_score", "truth_fields"]
+
+#: Rendering styles by name.
+STYLES = {"mannequin": Mannequin, "stick": Stick, "markers": Markers}
+
+
+def make_renderer(pose: Pose, camera: Camera, style: str = "mannequin"):
+    """The style's renderer: ``len(r)`` frames, ``r.frame(i)`` → (H, W, 3) uint8 BGR."""
+    if style not in STYLES:
+        raise SyntheticError(f"unknown style {style!r}; expected one of {', '.join(STYLES)}")
+    return STYLES[style](pose, camera)
+
+
+def render_frames(pose: Pose, camera: Camera, style: str = "mannequin") -> Iterator[np.ndarray]:
+    """Yield the frames of `pose` seen by `camera`, (H, W, 3) uint8 BGR each."""
+    r = make_renderer(pose, camera, style)
+    for i in range(len(r)):
+        yield r.frame(i)
+
+
+def truth_fields(pose: Pose, camera: Camera, *, score_json: str = "null", effort_json: str = "null",
+                 view: str = "", style: str = "") -> dict:
+    """Every field of the truth sidecar for `pose` seen by `camera`.
+
+    Returns
+    -------
+    dict
+        Keyword arguments for :func:`capture2notation.io.truth.write_truth`.
+    """
+    return {
+        "fps": pose.fps,
+        "times": pose.times,
+        "joint_names": np.array(JOINTS),
+        "joints": pose.joints,
+        "angles": pose.angles,
+        "root": pose.root,
+        "landmarks3d": pose.landmarks,
+        "keypoints": camera.project(pose.landmarks),
+        "visibility": landmark_visibility(pose, camera),
+        "K": camera.K,
+        "R": camera.R,
+        "t": camera.t,
+        "image_size": np.array(camera.size),
+        "score": score_json,
+        "effort": effort_json,
+        "view": view,
+        "style": style,
+        "body_height": pose.body.height,
+    }
+
+
+def render_pose(
+    pose: Pose,
+    outdir,
+    *,
+    size=(640, 480),
+    view: str = "front",
+    style: str = "mannequin",
+    video_name: str = "video.mp4",
+    score_json: str = "null",
+    effort_json: str = "null",
+    progress: bool = False,
+) -> Path:
+    """Render `pose` into `outdir` (video and ``truth.npz``); return the video path."""
+    outdir = Path(outdir)
+    camera = Camera.for_view(view, size, pose.body.height)
+    renderer = make_renderer(pose, camera, style)
+    fields = truth_fields(pose, camera, score_json=score_json, effort_json=effort_json, view=view, style=style)
+    video = outdir / video_name
+    frames = range(len(renderer))
+    if progress:
+        from tqdm import tqdm
+
+        frames = tqdm(frames, desc=f"render {style} {view}", unit="frame", leave=False)
+    with open_writer(video, pose.fps, camera.size) as writer:
+        for i in frames:
+            writer.write(renderer.frame(i))
+    write_truth(outdir / "truth.npz", **fields)
+    return video
+
+
+def render_motion(motion, outdir, **kw) -> Path:
+    """Render a ``synthetic.motion.Motion`` (anything with fps, angles, root, body); see :func:`render_pose`."""
+    return render_pose(Pose.from_motion(motion), outdir, **kw)
+
+
+def render_score(
+    score,
+    outdir,
+    fps: float = 25.0,
+    size=(640, 480),
+    view: str = "front",
+    style: str = "mannequin",
+    emotion: str | None = None,
+    progress: bool = True,
+    body: Body | None = None,
+) -> Path:
+    """Perform a score with the virtual dancer and render it.
+
+    Writes ``OUTDIR/video.mp4``, ``OUTDIR/truth.npz`` and ``OUTDIR/score.lab``.
+
+    Parameters
+    ----------
+    score : capture2notation.notation.Score
+    outdir : str or Path
+    fps : float
+        Frames per second.
+    size : (int, int)
+        Image (width, height), pixels.
+    view : {"front", "45", "side"}
+    style : {"mannequin", "stick", "markers"}
+    emotion : str, optional
+        Perform with this emotion preset (its Effort and tempo).
+    progress : bool
+        Show a progress bar over frames.
+    body : Body, optional
+        Default ``Body()``.
+
+    Returns
+    -------
+    Path
+        The output folder.
+    """
+    from capture2notation.notation.formats import dumps, write
+
+    from ..interpret import interpret
+
+    if view not in VIEWS:
+        raise SyntheticError(f"unknown view {view!r}; expected one of {', '.join(VIEWS)}")
+    if style not in STYLES:
+        raise SyntheticError(f"unknown style {style!r}; expected one of {', '.join(STYLES)}")
+    if emotion is not None:
+        score = score.with_emotion(emotion)
+    motion = interpret(score, fps, body or Body())
+    outdir = Path(outdir)
+    render_motion(
+        motion,
+        outdir,
+        size=size,
+        view=view,
+        style=style,
+        score_json=dumps(score, "json"),
+        effort_json=json.dumps(asdict(score.resolved_effort())),
+        progress=progress,
+    )
+    write(score, outdir / "score.lab")
+    return outdir

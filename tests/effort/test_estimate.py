@@ -1,0 +1,103 @@
+"""estimate_effort end to end on reference arcs; effort.json and c2n effort."""
+
+import json
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from capture2notation.body import joint_index
+from capture2notation.effort import estimate_effort, write_effort
+from capture2notation.effort.testing import arc_motion, random_arm_score
+from capture2notation.errors import EffortError
+from capture2notation.notation import Score, Symbol, write
+from capture2notation.notation.model import Effort
+
+FIELDS = {"part", "start", "duration", "time", "weight", "space", "tau", "acceptance", "converged"}
+
+
+@pytest.fixture(scope="module")
+def angry():
+    """Three angry-like arm movements plus a held support, 4 mm joint noise."""
+    eff = Effort(time=-3.51, weight=0.41, space=1.0)
+    score = random_arm_score(np.random.default_rng(4), 3, tempo=79, effort=eff)
+    score = score.replace(symbols=score.symbols + (Symbol(0, 4, "support", "place", "middle"),))
+    joints = arc_motion(score, 25.0)
+    joints = joints + 0.004 * np.random.default_rng(5).standard_normal(joints.shape)
+    result = estimate_effort(joints, None, 25.0, score, rng=1)
+    return score, joints, result
+
+
+def test_movements_pooled_and_emotion(angry):
+    score, _, res = angry
+    assert len(res.movements) == 3  # the support symbol bears no Effort
+    assert all(m.posterior.converged for m in res.movements)
+    b = res.pooled.posterior.summary(0)
+    x0 = res.pooled.posterior.summary(1)
+    assert b["median"] == pytest.approx(-3.51, abs=0.3)
+    assert x0["median"] == pytest.approx(0.41, abs=0.03)
+    assert res.pooled.space.median > 0.8
+    assert res.tempo == 79
+    assert sum(res.emotion.values()) == pytest.approx(1.0)
+    assert max(res.emotion, key=res.emotion.get) == "angry"
+    assert set(res.parts) == {"right_arm"} and res.parts["right_arm"].n_movements == 3
+
+
+def test_effort_json_has_the_issue_fields(angry, tmp_path):
+    _, _, res = angry
+    paths = write_effort(res, tmp_path, plots=True, rng=0)
+    data = json.loads(paths["json"].read_text())
+    assert len(data["movements"]) == 3
+    for m in data["movements"]:
+        assert FIELDS <= set(m)
+        assert m["time"]["ci90"][0] <= m["time"]["median"] <= m["time"]["ci90"][1]
+        assert 0 <= m["space"]["ci90"][0] <= m["space"]["ci90"][1] <= 1
+    assert FIELDS - {"part", "start", "duration"} | {"tempo"} <= set(data["pooled"])
+    assert set(data["emotion"]) == {"happy", "sad", "angry", "afraid"}
+    for key in ("progress", "pooled"):
+        assert paths[key].stat().st_size > 10_000
+        assert paths[key].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_results_do_not_depend_on_worker_count():
+    score = random_arm_score(np.random.default_rng(9), 2, tempo=60, effort=Effort(-2.5, 0.55, 1.0))
+    joints = arc_motion(score, 25.0) + 0.003 * np.random.default_rng(2).standard_normal((1, 1, 1))
+    kw = {"block": 50, "max_steps": 100}
+    one = estimate_effort(joints, None, 25.0, score, rng=7, sampler_kw=kw)
+    two = estimate_effort(joints, None, 25.0, score, rng=7, workers=2, sampler_kw=kw)
+    for a, b in zip(one.movements, two.movements):
+        np.testing.assert_array_equal(a.posterior.samples, b.posterior.samples)
+    assert not any(m.posterior.converged for m in one.movements)  # 100 steps: honestly unconverged
+    assert json.dumps(one.to_dict()) == json.dumps(two.to_dict())
+
+
+def test_unmeasurable_movements_are_skipped_with_a_reason():
+    score = Score(symbols=(Symbol(0, 1, "right_arm", "forward", "middle"), Symbol(3, 2, "left_arm", "right", "high")),
+                  tempo=Fraction(60))
+    joints = arc_motion(score, 25.0)[:60]  # the second movement runs past the capture
+    joints[:, joint_index("left_wrist")] = np.nan
+    res = estimate_effort(joints, None, 25.0, score, rng=0)
+    assert len(res.movements) == 1
+    assert res.skipped[0]["part"] == "left_arm" and "outside the capture" in res.skipped[0]["reason"]
+    assert res.pooled is not None and res.parts == {}
+    with pytest.raises(EffortError, match="rng"):
+        estimate_effort(joints, None, 25.0, score, rng=None)
+
+
+def test_c2n_effort_command(angry, tmp_path):
+    from pipelines.cli import main
+
+    score, joints, _ = angry
+    t = np.arange(len(joints)) / 25.0
+    conf = np.ones(joints.shape[:2])
+    np.savez(tmp_path / "capture.npz", joints=joints, confidence=conf, fps=np.float64(25.0), times=t)
+    write(score, tmp_path / "score.lab")
+    out = CliRunner().invoke(main, ["effort", str(tmp_path), "--workers", "1", "--no-plots"])
+    assert out.exit_code == 0, out.output
+    data = json.loads((tmp_path / "effort.json").read_text())
+    assert data["pooled"]["tempo"] == 79
+    assert "angry" in out.output
+    (tmp_path / "capture.npz").unlink()
+    out = CliRunner().invoke(main, ["effort", str(tmp_path)])
+    assert out.exit_code == 2 and "capture.npz" in out.output

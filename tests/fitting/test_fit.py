@@ -1,0 +1,135 @@
+"""Fitting known poses back from their (noisy, partial) observations."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from fitting_helpers import limb_direction_errors, make_motion, observe
+
+from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
+from capture2notation.errors import FittingError
+from capture2notation.fitting import Camera, FitResult, fit_keypoints, fit_points3d, fit_track
+
+T = 40
+
+
+@pytest.fixture(scope="module")
+def scene():
+    body = Body()
+    ang, root = make_motion(T, seed=3, body=body)
+    cam = Camera.default((640, 480))
+    return body, ang, root, cam
+
+
+def _mpjpe(a, b):
+    return float(np.nanmean(np.linalg.norm(a - b, axis=-1)))
+
+
+def test_clean_keypoints_with_world_landmarks_are_fitted_closely(scene):
+    body, ang, root, cam = scene
+    xy, conf, world, truth = observe(ang, root, cam, body)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    assert isinstance(res, FitResult)
+    assert res.joints.shape == (T, len(JOINTS), 3) and res.confidence.shape == (T, len(JOINTS))
+    assert _mpjpe(res.joints, truth) < 0.02
+    assert np.median(limb_direction_errors(res.joints, truth)) < 1.0
+    # The output is self-consistent: FK of the angles with the clip's offsets gives the joints.
+    from capture2notation.fitting import PoseModel
+    model = PoseModel(body, res.offsets)
+    np.testing.assert_allclose(model.forward(model.params(res.angles, res.root))[:, : len(JOINTS)],
+                               res.joints, atol=1e-9)
+    assert np.all(res.confidence[:, joint_index("right_wrist")] > 0.8)
+
+
+def test_noisy_keypoints_stay_within_a_few_degrees(scene):
+    body, ang, root, cam = scene
+    xy, conf, world, truth = observe(ang, root, cam, body, noise_px=3.0, seed=1)
+    world = world + np.random.default_rng(2).normal(0.0, 0.02, world.shape)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    assert _mpjpe(res.joints, truth) < 0.06
+    assert np.median(limb_direction_errors(res.joints, truth)) < 5.0
+
+
+def test_joint_limits_hold(scene):
+    body, ang, root, cam = scene
+    xy, conf, world, _ = observe(ang, root, cam, body, noise_px=8.0, seed=4)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    lim = body.limits
+    inside = (res.angles[:, 1:] >= lim[1:, :, 0] - 1e-9) & (res.angles[:, 1:] <= lim[1:, :, 1] + 1e-9)
+    assert inside.all()
+
+
+def test_missing_landmarks_lower_confidence_and_empty_frames_are_nan(scene):
+    body, ang, root, cam = scene
+    xy, conf, world, truth = observe(ang, root, cam, body)
+    xy, conf, world = xy.copy(), conf.copy(), world.copy()
+    # Right wrist (16) unseen in frames 10-19; nothing at all in frames 30-32.
+    xy[10:20, 16] = np.nan
+    conf[10:20, 16] = 0.0
+    world[10:20, 16] = np.nan
+    xy[30:33], conf[30:33], world[30:33] = np.nan, 0.0, np.nan
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    rw = joint_index("right_wrist")
+    assert np.all(res.confidence[10:20, rw] == 0.0)
+    assert np.all(res.confidence[:10, rw] > 0.8)
+    assert np.all(np.isnan(res.joints[30:33])) and np.all(res.confidence[30:33] == 0.0)
+    assert np.all(np.isfinite(res.joints[:30]))
+    # The rest of the body is still fitted well where observed.
+    ok = np.r_[0:30, 33:T]
+    assert _mpjpe(res.joints[ok], truth[ok]) < 0.03
+
+
+def test_unknown_camera_uses_the_default_and_sets_the_floor():
+    body = Body()
+    ang, root = make_motion(30, seed=7, body=body)
+    for leg in ("right_hip", "right_knee", "left_hip", "left_knee"):
+        ang[:, joint_index(leg)] = 0.0  # feet stay on the floor
+    cam = Camera.default((640, 480), hfov_deg=55.0)
+    xy, conf, world, truth = observe(ang, root, cam, body, noise_px=1.0)
+    res = fit_keypoints(xy, conf, 25.0, world=world, image_size=(640, 480))
+    rel = lambda j: j - j[:, :1]  # noqa: E731 - root-relative pose
+    assert _mpjpe(rel(res.joints), rel(truth)) < 0.04
+    feet = [joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("ankle", "toe")]
+    assert np.max(np.abs(res.joints[:, feet, 2] - truth[:, feet, 2])) < 0.02
+    with pytest.raises(FittingError, match="image_size"):
+        fit_keypoints(xy, conf, 25.0, world=world)
+
+
+def test_fit_track_reads_a_keypoint_track(scene):
+    body, ang, root, cam = scene
+    xy, conf, world, truth = observe(ang[:10], root[:10], cam, body)
+    xyz = np.concatenate([xy, np.zeros((10, 33, 1))], axis=-1)
+    presence = np.ones(10)
+    presence[4] = 0.0  # no person found in frame 4
+    track = SimpleNamespace(xy=xyz, visibility=conf, presence=presence, world=world, fps=25.0,
+                            times=np.arange(10) / 25.0, image_size=np.array([640, 480]))
+    res = fit_track(track, camera=cam)
+    assert np.all(np.isnan(res.joints[4])) and np.all(res.confidence[4] == 0)
+    ok = np.r_[0:4, 5:10]
+    assert _mpjpe(res.joints[ok], truth[ok]) < 0.03
+    np.testing.assert_allclose(res.times, track.times)
+
+
+def test_3d_points_fit_recovers_the_pose():
+    body = Body(1.8)
+    ang, root = make_motion(30, seed=11, body=body)
+    truth = forward_kinematics(ang, root, body)
+    conf = np.ones(truth.shape[:2])
+    res = fit_points3d(truth, conf, 25.0)
+    assert _mpjpe(res.joints, truth) < 0.01
+    assert np.median(limb_direction_errors(res.joints, truth)) < 1.0
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: fit_keypoints(np.zeros((5, 17, 2)), np.ones((5, 17)), 25.0, image_size=(64, 48)), "33"),
+        (lambda: fit_keypoints(np.zeros((5, 33, 2)), np.ones((5, 32)), 25.0, image_size=(64, 48)), "confidence"),
+        (lambda: fit_keypoints(np.zeros((5, 33, 2)), np.ones((5, 33)), 0.0, image_size=(64, 48)), "fps"),
+        (lambda: fit_keypoints(np.zeros((0, 33, 2)), np.ones((0, 33)), 25.0, image_size=(64, 48)), "no frames"),
+        (lambda: fit_points3d(np.zeros((5, 3, 3)), np.ones((5, 3)), 25.0), "points"),
+    ],
+)
+def test_bad_inputs_name_the_problem(call, message):
+    with pytest.raises(FittingError, match=message):
+        call()

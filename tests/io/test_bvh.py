@@ -1,0 +1,155 @@
+"""BVH: the fixtures read with plausible figures; our files round-trip; errors name the line."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
+from capture2notation.errors import MotionFileError
+from capture2notation.io.bvh import (
+    bvh_positions,
+    canonical_name,
+    map_joints,
+    parse_bvh,
+    read_bvh_points,
+    write_bvh,
+)
+from capture2notation.io.motion import read_motion
+
+FIXTURES = [("bvh/jesse_dance.bvh", 1007, 100.0), ("bvh/test_mocapbank.bvh", 455, 30.0)]
+
+
+@pytest.mark.parametrize("rel, frames, fps", FIXTURES)
+def test_fixtures_parse_with_their_frame_counts_and_rates(fixture_path, rel, frames, fps):
+    skel = parse_bvh(fixture_path(rel))
+    assert skel.motion.shape[0] == frames
+    assert skel.fps == pytest.approx(fps, rel=1e-4)
+    points, conf, _, got_fps = read_bvh_points(fixture_path(rel))
+    assert points.shape == (frames, len(JOINTS), 3)
+    # Every joint we need is found by name in both styles.
+    for name in ("pelvis", "right_shoulder", "left_elbow", "right_wrist", "left_hip", "right_knee", "left_ankle"):
+        assert conf[0, joint_index(name)] == 1.0, name
+    # Metres, z up: the figure is human-sized and the head is above the feet.
+    extent = np.nanmax(points[..., 2], axis=1) - np.nanmin(points[..., 2], axis=1)
+    assert 1.2 <= np.percentile(extent, 90) <= 2.2
+    assert np.all(points[:, joint_index("neck"), 2] > points[:, joint_index("right_ankle"), 2])
+
+
+def test_mixamo_and_bvh_python_shoulders_are_told_apart():
+    mixamo = ["mixamorig:Hips", "mixamorig:Spine", "mixamorig:LeftShoulder", "mixamorig:LeftArm",
+              "mixamorig:LeftForeArm", "mixamorig:LeftHand"]
+    m = map_joints(mixamo)
+    assert mixamo[m["left_shoulder"]] == "mixamorig:LeftArm"  # LeftShoulder is the collar
+    assert mixamo[m["left_elbow"]] == "mixamorig:LeftForeArm"
+    other = ["Hips", "Chest", "LeftCollar", "LeftShoulder", "LeftElbow", "LeftWrist", "LeftWrist_End"]
+    m = map_joints(other)
+    assert other[m["left_shoulder"]] == "LeftShoulder"
+    assert other[m["left_hand_tip"]] == "LeftWrist_End"
+    cmu = ["Hips", "LHipJoint", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "LowerBack", "Spine", "Spine1"]
+    m = map_joints(cmu)
+    assert [cmu[m[j]] for j in ("left_hip", "left_knee", "left_ankle", "left_toe", "waist", "chest")] == \
+        ["LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "Spine", "Spine1"]
+    assert canonical_name("mixamorig1:Left_Fore-Arm") == "leftforearm"
+
+
+def test_user_map_overrides_the_table_and_unknown_names_fail():
+    names = ["root", "thing_l", "thing_r"]
+    m = map_joints(names, {"thing_l": "left_hip", "thing_r": "right_hip"})
+    assert m["left_hip"] == 1 and m["right_hip"] == 2 and m["pelvis"] == 0
+    with pytest.raises(MotionFileError, match="not one of our joints"):
+        map_joints(names, {"thing_l": "left_flipper"})
+    with pytest.raises(MotionFileError, match="not in the file"):
+        map_joints(names, {"nope": "left_hip"})
+
+
+def _motion(T=12, seed=0):
+    rng = np.random.default_rng(seed)
+    body = Body()
+    t = np.arange(T)[:, None] / T
+    ang = np.zeros((T, len(JOINTS), 3))
+    ang[:, 1:] = rng.normal(0.0, 0.4, (1, len(JOINTS) - 1, 3)) * np.sin(np.pi * t)[..., None]
+    ang[:, 0, 2] = 0.5 * t[:, 0]
+    ang = body.clip(ang)
+    root = np.tile(body.rest[0], (T, 1)) + np.c_[0.2 * t, 0.1 * t, 0 * t]
+    return body, ang, root
+
+
+@pytest.mark.parametrize("unit", ["cm", "m"])
+def test_write_then_read_round_trips(tmp_path, unit):
+    body, ang, root = _motion()
+    path = write_bvh(tmp_path / "m.bvh", ang, root, 25.0, unit=unit)
+    m = read_motion(path)
+    assert m.source == "bvh" and m.fps == pytest.approx(25.0)
+    np.testing.assert_allclose(m.angles, ang, atol=1e-6)
+    np.testing.assert_allclose(m.root, root, atol=1e-6)
+    np.testing.assert_allclose(m.joints, forward_kinematics(ang, root, body), atol=1e-5)
+
+
+def test_written_file_is_y_up_with_our_rotation_order(tmp_path):
+    body, ang, root = _motion(seed=3)
+    path = write_bvh(tmp_path / "m.bvh", ang, root, 25.0, unit="m")
+    skel = parse_bvh(path)
+    assert skel.channels[0] == ["xposition", "yposition", "zposition", "yrotation", "zrotation", "xrotation"]
+    # The file's own FK (any BVH reader) reproduces our joints in y-up axes.
+    pos = bvh_positions(skel)
+    idx = [skel.names.index(j) for j in JOINTS]
+    fk = forward_kinematics(ang, root, body)
+    np.testing.assert_allclose(pos[:, idx], np.stack([fk[..., 0], fk[..., 2], -fk[..., 1]], -1), atol=1e-5)
+    # A generic reader (IK by name, not our angles) lands on the same joints.
+    points, conf, _, _ = read_bvh_points(path)
+    np.testing.assert_allclose(points, fk, atol=1e-5)
+
+
+@settings(max_examples=25, deadline=None)
+@given(order=st.permutations(["X", "Y", "Z"]), angles=st.lists(st.floats(-170, 170), min_size=3, max_size=3))
+def test_channel_order_composes_left_to_right(tmp_path_factory, order, angles):
+    # One joint below the root: its child's position is R_first R_second R_third @ offset.
+    chans = " ".join(f"{a}rotation" for a in order)
+    text = (
+        "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 " + chans + "\n End Site\n {\n  OFFSET 0 1 0\n }\n}\n"
+        f"MOTION\nFrames: 1\nFrame Time: 0.04\n{angles[0]} {angles[1]} {angles[2]}\n"
+    )
+    path = tmp_path_factory.mktemp("bvh") / "one.bvh"
+    path.write_text(text)
+    pos = bvh_positions(parse_bvh(path))[0, 1]
+    R = np.eye(3)
+    for axis, deg in zip(order, angles):
+        c, s = np.cos(np.deg2rad(deg)), np.sin(np.deg2rad(deg))
+        i = "XYZ".index(axis)
+        j, k = (i + 1) % 3, (i + 2) % 3
+        m = np.eye(3)
+        m[j, j] = m[k, k] = c
+        m[k, j], m[j, k] = s, -s
+        R = R @ m
+    np.testing.assert_allclose(pos, R @ [0, 1, 0], atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 zero 0\n", ":4: expected a number for OFFSET of Hips"),
+        ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Wrotation\n}\n", ":5: unknown channel"),
+        ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 3\nFrame Time: 0.1\n1 2\n",
+         "2 values, expected 3 frames"),
+        ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\nx\n",
+         ":10: expected a channel value"),
+        ("MOTION\n", ":1: expected 'HIERARCHY'"),
+    ],
+)
+def test_malformed_files_name_the_line(tmp_path, text, message):
+    path = tmp_path / "bad.bvh"
+    path.write_text(text)
+    with pytest.raises(MotionFileError, match=message):
+        parse_bvh(path)
+
+
+def test_file_without_needed_joints_asks_for_a_map(tmp_path):
+    text = ("HIERARCHY\nROOT Blob\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n  OFFSET 0 1 0\n }\n}\n"
+            "MOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n")
+    path = tmp_path / "blob.bvh"
+    path.write_text(text)
+    with pytest.raises(MotionFileError, match="joint_map"):
+        read_bvh_points(path)

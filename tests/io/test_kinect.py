@@ -1,0 +1,136 @@
+"""Kinect v2 skeleton CSV (LabanotationSuite format): layout, tracking states, gaps, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from capture2notation.body import JOINTS, Body, joint_index
+from capture2notation.errors import MotionFileError
+from capture2notation.fitting import PoseModel
+from capture2notation.io.kinect import (
+    KINECT_JOINTS,
+    KINECT_TO_JOINT,
+    camera_to_world,
+    read_kinect_csv,
+    write_kinect_csv,
+)
+from capture2notation.io.kinect import world_to_camera
+from capture2notation.io.motion import read_motion
+
+# The performer stands 2.5 m in front of a sensor 0.8 m above the floor.
+_SENSOR = np.array([0.0, 2.5, 0.8])
+
+
+def _pose_sequence(T=15):
+    """Angles, root and the model's points for a right-arm raise (feet on the floor)."""
+    body = Body()
+    model = PoseModel(body)
+    ang = np.zeros((T, len(JOINTS), 3))
+    ang[:, joint_index("right_shoulder"), 0] = np.linspace(0.0, 1.6, T)
+    ang[:, joint_index("left_elbow"), 0] = np.linspace(0.0, 1.0, T)
+    root = np.tile(body.rest[0], (T, 1))
+    pts = model.forward(model.params(ang, root))
+    return model, pts
+
+
+def _kinect_rows(model, pts):
+    """Camera-space positions (T, 25, 3) of the Kinect joints for our model's points."""
+    T = pts.shape[0]
+    out = np.zeros((T, 25, 3))
+    for k, name in enumerate(KINECT_JOINTS):
+        if name in KINECT_TO_JOINT:
+            p = pts[:, model.index(KINECT_TO_JOINT[name][0])]
+        elif name == "Neck":
+            p = 0.5 * (pts[:, model.index("neck")] + pts[:, model.index("head_centre")])
+        else:  # hands and thumbs: between wrist and hand tip
+            side = "left" if "Left" in name else "right"
+            p = 0.5 * (pts[:, model.index(f"{side}_wrist")] + pts[:, model.index(f"{side}_hand_tip")])
+        out[:, k] = p
+    # World -> camera space: the sensor looks along world -y at the performer.
+    return world_to_camera(out - _SENSOR)
+
+
+def test_joint_order_is_the_kinect_sdk_order():
+    assert len(KINECT_JOINTS) == 25
+    assert KINECT_JOINTS[:4] == ("SpineBase", "SpineMid", "Neck", "Head")
+    assert KINECT_JOINTS[20] == "SpineShoulder" and KINECT_JOINTS[24] == "ThumbRight"
+
+
+def test_camera_axes_map_to_ours():
+    # Sensor-left (+x) is the facing performer's right (+x); up is up; away from the sensor is -y.
+    np.testing.assert_allclose(camera_to_world(np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])),
+                               [[1, 0, 0], [0, 0, 1], [0, -1, 0]])
+    p = np.random.default_rng(0).normal(size=(4, 3))
+    np.testing.assert_allclose(world_to_camera(camera_to_world(p)), p)
+
+
+def test_csv_of_a_known_pose_reads_back_as_that_pose(tmp_path):
+    model, pts = _pose_sequence()
+    T = pts.shape[0]
+    cam = _kinect_rows(model, pts)
+    states = np.full((T, 25), 2)
+    path = write_kinect_csv(tmp_path / "take.csv", np.arange(T) / 30.0, cam, states)
+    first = path.read_text().splitlines()[0].split(",")
+    assert len(first) == 101 and int(first[0]) > 10**7  # ticks, no header
+    m = read_motion(path)
+    assert m.source == "kinect" and m.fps == pytest.approx(30.0, rel=1e-5)
+    truth = pts[:, : len(JOINTS)]
+    limbs = [("right_shoulder", "right_elbow"), ("right_elbow", "right_wrist"), ("left_elbow", "left_wrist"),
+             ("right_hip", "right_knee"), ("left_knee", "left_ankle")]
+    for a, b in limbs:
+        u = truth[:, joint_index(b)] - truth[:, joint_index(a)]
+        v = m.joints[:, joint_index(b)] - m.joints[:, joint_index(a)]
+        cos = np.sum(u * v, -1) / np.linalg.norm(u, axis=-1) / np.linalg.norm(v, axis=-1)
+        assert np.degrees(np.arccos(np.clip(cos, -1, 1))).max() < 3.0, (a, b)
+    # Floor at z = 0 and the performer at the origin facing +y.
+    assert abs(m.joints[0, joint_index("pelvis"), 0]) < 0.01 and abs(m.joints[0, joint_index("pelvis"), 1]) < 0.01
+    np.testing.assert_allclose(m.joints[:, joint_index("right_ankle"), 2], truth[:, joint_index("right_ankle"), 2], atol=0.02)
+    assert m.joints[0, joint_index("right_hip"), 0] > m.joints[0, joint_index("left_hip"), 0]
+
+
+def test_tracking_states_and_dropped_frames(tmp_path):
+    model, pts = _pose_sequence(10)
+    cam = _kinect_rows(model, pts)
+    states = np.full((10, 25), 2)
+    states[:, KINECT_JOINTS.index("WristRight")] = 1  # inferred
+    states[:, KINECT_JOINTS.index("HandTipLeft")] = 0  # not tracked
+    times = np.arange(10) / 30.0
+    times[5:] += 2 / 30.0  # two frames dropped after the fifth
+    path = write_kinect_csv(tmp_path / "gaps.csv", times, cam, states)
+    t, pos, conf, fps = read_kinect_csv(path)
+    assert pos.shape == (12, 25, 3) and fps == pytest.approx(30.0, rel=1e-5)
+    assert np.all(np.isnan(pos[5:7])) and np.all(conf[5:7] == 0)
+    assert np.all(np.isnan(pos[:, KINECT_JOINTS.index("HandTipLeft")]))
+    np.testing.assert_allclose(conf[0, KINECT_JOINTS.index("WristRight")], 0.3)
+    m = read_motion(path)
+    assert np.all(np.isnan(m.joints[5:7])) and np.all(m.confidence[5:7] == 0)
+    rw, lt, re = (joint_index(n) for n in ("right_wrist", "left_hand_tip", "right_elbow"))
+    ok = np.r_[0:5, 7:12]
+    assert np.all(m.confidence[ok, rw] < 0.35) and np.all(m.confidence[ok, lt] < 0.6)
+    assert np.all(m.confidence[ok, re] > 0.8)
+
+
+def test_millisecond_timestamps_are_accepted(tmp_path):
+    model, pts = _pose_sequence(4)
+    cam = _kinect_rows(model, pts)
+    rows = [",".join([str(40 * i)] + [f"{v:.4f}" for j in range(25) for v in (*cam[i, j], 2)]) for i in range(4)]
+    path = tmp_path / "ms.csv"
+    path.write_text("\n".join(rows) + "\n")
+    t, _, _, fps = read_kinect_csv(path)
+    assert fps == pytest.approx(25.0) and t[-1] == pytest.approx(0.12)
+
+
+@pytest.mark.parametrize(
+    "line, message",
+    [
+        ("time,x,y,z,s", ":1: expected a timestamp and 25 joints"),
+        (",".join(["100000000"] + ["0.1"] * 100), ":1: tracking state of SpineBase is 0.1"),
+        (",".join(["100000000"] + ["a"] * 100), ":1: expected numbers, found 'a'"),
+    ],
+)
+def test_malformed_rows_name_the_line(tmp_path, line, message):
+    path = tmp_path / "bad.csv"
+    path.write_text(line + "\n")
+    with pytest.raises(MotionFileError, match=message):
+        read_kinect_csv(path)

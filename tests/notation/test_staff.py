@@ -1,0 +1,155 @@
+"""The Labanotation staff drawing (staff.svg / PNG)."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from capture2notation.errors import NotationError
+from capture2notation.notation import Score, Symbol
+from capture2notation.notation.formats import lab
+from capture2notation.notation.staff import render_staff, staff_layout, svg_text, symbol_outline
+
+SVG = "{http://www.w3.org/2000/svg}"
+
+PHRASE = lab.loads("""\
+title: Figure 7 <&> $test\x01
+tempo: 60
+meter: 2
+0 4 right_support place middle
+0 1 left_support place middle
+1 1 left_leg forward middle
+2 1/2 left_leg left middle
+3 1 left_leg left low
+0 2 right_arm right high bend=2
+1 3 head forward high
+2 1 chest right_back middle
+""")
+
+
+def _symbol_groups(root):
+    return [g for g in root.iter(f"{SVG}g") if "symbol" in g.get("class", "").split()]
+
+
+def _polygon_y_extent(g) -> float:
+    """Summed vertical extent of a symbol's outline pieces, pixels."""
+    total = 0.0
+    for poly in g.findall(f"{SVG}polygon"):
+        pts = np.array([[float(v) for v in p.split(",")] for p in poly.get("points").split()])
+        total += pts[:, 1].max() - pts[:, 1].min()
+    return total
+
+
+def test_svg_parses_and_has_one_group_per_symbol(tmp_path):
+    out = render_staff(PHRASE, tmp_path / "staff.svg", tmp_path / "staff.png")
+    root = ET.parse(out).getroot()
+    assert root.tag == f"{SVG}svg"
+    groups = _symbol_groups(root)
+    assert len(groups) == len(PHRASE.symbols)
+    assert sorted(g.get("id") for g in groups) == sorted(f"sym-{i}" for i in range(len(PHRASE.symbols)))
+    for g in groups:
+        s = PHRASE.symbols[int(g.get("id").split("-")[1])]
+        assert g.get("data-part") == s.part and g.get("data-direction") == s.direction
+        assert g.get("data-level") == s.level and int(g.get("data-bend")) == s.bend
+        assert Fraction(g.get("data-start")) == s.start and Fraction(g.get("data-duration")) == s.duration
+    # XML specials are escaped, characters XML forbids replaced, '$' is not maths.
+    assert any(t.text == "Figure 7 <&> $test\ufffd" for t in root.iter(f"{SVG}text"))
+    png = (tmp_path / "staff.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.from_type(Score), st.sampled_from([None, 1, 2, 8]))
+def test_vertical_extent_is_proportional_to_duration(score, measures_per_staff):
+    lay = staff_layout(score, beat_height=40.0, measures_per_staff=measures_per_staff)
+    root = ET.fromstring(svg_text(lay).encode())
+    groups = _symbol_groups(root)
+    assert len(groups) == len(score.symbols)
+    for g in groups:
+        dur = Fraction(g.get("data-duration"))
+        assert _polygon_y_extent(g) == pytest.approx(40.0 * float(dur), abs=0.02)
+
+
+def test_time_runs_bottom_to_top_and_sides():
+    lay = staff_layout(PHRASE)
+    by_part = {}
+    for g in lay.glyphs:
+        by_part.setdefault(g.symbol.part, []).append(g)
+    legs = sorted(by_part["left_leg"], key=lambda g: g.symbol.start)
+    # Later symbols are higher on the page (smaller y).
+    assert legs[0].foot[1] > legs[1].foot[1] > legs[2].foot[1]
+    centre = np.mean([g.centre[0] for g in by_part["right_support"] + by_part["left_support"]])
+    assert by_part["right_arm"][0].pieces[0][:, 0].min() > centre > by_part["left_leg"][0].pieces[0][:, 0].max()
+    # Column order outwards on the right: support, leg, body, arm, head.
+    x = {p: by_part[p][0].centre[0] for p in ("right_support", "chest", "right_arm", "head")}
+    assert x["right_support"] < x["chest"] < x["right_arm"] < x["head"]
+
+
+def test_levels_and_bend_marks(tmp_path):
+    root = ET.parse(render_staff(PHRASE, tmp_path / "s.svg")).getroot()
+    for g in _symbol_groups(root):
+        poly = g.find(f"{SVG}polygon")
+        level = g.get("data-level")
+        fill = poly.get("fill")
+        assert fill == {"high": "url(#hatch)", "middle": "white", "low": "black"}[level]
+        assert (g.find(f"{SVG}circle") is not None) == (level == "middle")
+        bend = g.find(f"{SVG}text")
+        assert (bend is not None) == (g.get("data-bend") != "0")
+        if bend is not None:
+            assert bend.text == "\u00d72"
+
+
+@pytest.mark.parametrize("direction,n_vertices", [("place", 4), ("forward", 6), ("back", 6),
+                                                  ("right_forward", 4), ("left_back", 4)])
+def test_shapes_fill_their_box(direction, n_vertices):
+    pts = symbol_outline(direction, 10.0, 200.0, 40.0, 100.0, "right")
+    assert len(pts) == n_vertices
+    assert pts[:, 0].min() == 10.0 and pts[:, 0].max() == 40.0
+    assert pts[:, 1].min() == 100.0 and pts[:, 1].max() == 200.0
+
+
+def test_side_symbols_point_sideways():
+    short = symbol_outline("right", 0.0, 30.0, 30.0, 0.0, "right")
+    assert len(short) == 3 and tuple(short[1]) == (30.0, 15.0)  # apex at the right, mid-height
+    long = symbol_outline("left", 0.0, 300.0, 30.0, 0.0, "left")
+    assert len(long) == 4 and long[:, 0].min() == 0.0
+    assert set(map(tuple, long[long[:, 0] == 30.0])) == {(30.0, 300.0), (30.0, 0.0)}  # straight edge outside
+
+
+def test_bar_lines_follow_the_meter():
+    score = Score(symbols=(Symbol(0, 7, "head", "forward", "high"),), meter=3)
+    lay = staff_layout(score, beat_height=10.0)
+    widths = {round(x1 - x0) for x0, y0, x1, y1, _ in lay.lines if y0 == y1}
+    bars = [ln for ln in lay.lines if ln[1] == ln[3] and round(ln[2] - ln[0]) == max(widths)]
+    # 3 measures of 3 beats: double lines at 0 and 9 (2 each) + bar lines at 3 and 6.
+    assert len(bars) == 6
+    numbers = [t[2] for t in lay.texts if t[2].isdigit()]
+    assert numbers == ["1", "2", "3"]
+
+
+def test_long_scores_continue_on_further_staves():
+    score = Score(symbols=(Symbol(0, 3, "head", "forward", "high"), Symbol(3, 6, "right_arm", "right", "low")),
+                  meter=2)
+    one = staff_layout(score, beat_height=10.0, measures_per_staff=None)
+    two = staff_layout(score, beat_height=10.0, measures_per_staff=2)  # 5 measures -> 3 staves
+    assert two.height < one.height and two.width > one.width
+    verticals = [ln for ln in two.lines if ln[0] == ln[2]]
+    assert len(verticals) == 3 * 3  # three staves of three lines
+    arm = next(g for g in two.glyphs if g.symbol.part == "right_arm")
+    # Beats 3-9 cross the breaks at beats 4 and 8: pieces of 1, 4 and 1 beats.
+    assert [round(p[:, 1].max() - p[:, 1].min(), 6) for p in arm.pieces] == [10.0, 40.0, 10.0]
+    assert arm.pieces[0][:, 0].min() < arm.pieces[1][:, 0].min() < arm.pieces[2][:, 0].min()
+    assert [t[2] for t in two.texts if t[2].isdigit()] == ["1", "2", "3", "4", "5"]
+    with pytest.raises(NotationError):
+        staff_layout(score, measures_per_staff=0)
+
+
+def test_empty_score_still_draws_a_staff(tmp_path):
+    root = ET.parse(render_staff(Score(), tmp_path / "e.svg")).getroot()
+    assert _symbol_groups(root) == []
+    assert len(list(root.iter(f"{SVG}line"))) > 3

@@ -1,0 +1,113 @@
+"""``c2n capture``: motion files and videos → notation files."""
+
+from __future__ import annotations
+
+import csv
+import json
+import sys
+from fractions import Fraction as F
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from capture2notation.body import JOINTS, Body
+from capture2notation.errors import PipelineError
+from capture2notation.io.truth import write_truth
+from capture2notation.notation import read
+from capture2notation.notation.model import Score, Symbol
+from capture2notation.quantise.agreement import score_differences
+from capture2notation.quantise.labels import LABEL_PARTS
+from pipelines.capture import capture, input_kind
+from pipelines.cli import main
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "quantise"))
+from quantise_motions import arm_angles, build_motion  # noqa: E402
+
+TEMPO = 72
+MOVES = [
+    (1, 1, "right_shoulder", arm_angles("right", "middle")),
+    (2, F(1, 2), "left_shoulder", arm_angles("forward", "high")),
+    (3, 1, "right_shoulder", np.zeros(3)),
+]
+EXPECTED = Score(
+    symbols=(
+        Symbol(1, 1, "right_arm", "right", "middle"),
+        Symbol(2, F(1, 2), "left_arm", "forward", "high"),
+        Symbol(3, 1, "right_arm", "place", "low"),
+    ),
+    tempo=TEMPO,
+)
+
+
+@pytest.fixture
+def sidecar(tmp_path):
+    """A truth sidecar of an FK motion (camera fields are placeholders: not used for motion input)."""
+    joints, angles = build_motion(MOVES, TEMPO)
+    T = joints.shape[0]
+    path = tmp_path / "in" / "truth.npz"
+    write_truth(
+        path,
+        fps=25.0, times=np.arange(T) / 25.0, joint_names=np.asarray(JOINTS), joints=joints, angles=angles,
+        root=joints[:, 0], landmarks3d=np.full((T, 33, 3), np.nan), keypoints=np.full((T, 33, 2), np.nan),
+        visibility=np.zeros((T, 33)), K=np.eye(3), R=np.eye(3), t=np.zeros(3), image_size=np.array([64, 48]),
+        score="{}", effort="{}", view="front", style="stick", body_height=Body().height,
+    )  # fmt: skip
+    return path
+
+
+def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
+    out = tmp_path / "out"
+    res = capture(sidecar, out, tempo=TEMPO, progress=False, effort=False)
+    assert res.kind == "truth" and res.score.tempo == TEMPO
+    for name in ("score.lab", "score.json", "laban_editor.json", "benesh.json", "labels.csv", "staff.svg",
+                 "staff.png", "capture.npz", "index.html"):
+        assert (out / name).is_file(), name
+    assert score_differences(EXPECTED, read(out / "score.lab")) == []
+    assert score_differences(EXPECTED, read(out / "score.json")) == []
+    rows = list(csv.DictReader((out / "labels.csv").open()))
+    assert len(rows) == res.n_frames * len(LABEL_PARTS)
+    ben = json.loads((out / "benesh.json").read_text())
+    assert [p["frame"] for p in ben["poses"]] == res.segmentation.key_frames.tolist()
+    with np.load(out / "capture.npz") as z:
+        assert z["joints"].shape == (res.n_frames, len(JOINTS), 3)
+        assert z["confidence"].shape == (res.n_frames, len(JOINTS))
+        assert float(z["fps"]) == 25.0
+        assert np.all(np.isnan(z["keypoints"]))  # no video: no keypoints, none invented
+    page = (out / "index.html").read_text()
+    assert 'src="staff.svg"' in page and "motion file" in page
+    assert any("overlay.mp4" in s for s in res.skipped)
+    # Nothing half-written is left behind.
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_estimated_tempo_and_fps_override(sidecar, tmp_path):
+    res = capture(sidecar, tmp_path / "o", progress=False, effort=False)
+    assert res.segmentation.tempo_estimated and res.score.tempo == TEMPO
+    # Played twice as fast, the same frames are twice the tempo.
+    res2 = capture(sidecar, tmp_path / "o2", fps_override=50.0, tempo=2 * TEMPO, progress=False, effort=False)
+    assert score_differences(EXPECTED, res2.score.replace(tempo=TEMPO)) == []
+
+
+def test_command_line(sidecar, tmp_path):
+    runner = CliRunner()
+    r = runner.invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "c"), "--tempo", str(TEMPO), "--no-effort"])
+    assert r.exit_code == 0, r.output
+    assert "3 symbols" in r.output and "given" in r.output
+    bad = tmp_path / "notes.txt"
+    bad.write_text("hello")
+    r = runner.invoke(main, ["capture", str(bad), "-o", str(tmp_path / "d")])
+    assert r.exit_code == 2 and "unknown input type '.txt'" in r.output
+    r = runner.invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "e"), "--grid", "x"])
+    assert r.exit_code == 2 and "--grid" in r.output
+
+
+def test_bad_inputs_are_named(tmp_path):
+    with pytest.raises(PipelineError, match="no such file"):
+        input_kind(tmp_path / "missing.mp4")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(PipelineError, match="no images"):
+        input_kind(tmp_path / "empty")
+    with pytest.raises(PipelineError, match="--tempo"):
+        capture(tmp_path / "x.bvh", tmp_path / "o", tempo=-1, progress=False)

@@ -1,0 +1,131 @@
+"""Segmentation of forward-kinematics motions into symbols (no virtual dancer needed)."""
+
+from __future__ import annotations
+
+from fractions import Fraction as F
+
+import numpy as np
+import pytest
+
+from capture2notation.body import Body
+from capture2notation.errors import QuantiseError
+from capture2notation.notation.model import Score, Symbol
+from capture2notation.quantise.agreement import compare_scores, score_differences
+from capture2notation.quantise.segment import SegmentParams, movement_spans, segment, segment_motion
+
+from quantise_motions import arm_angles, build_motion
+
+TEMPO = 64
+# An arm phrase: out to forward middle, up to forward high over half a beat,
+# straight on (no pause) to the right, a pause, and down again over two beats.
+MOVES = [
+    (1, 1, "right_shoulder", arm_angles("forward", "middle")),
+    (2, F(1, 2), "right_shoulder", arm_angles("forward", "high")),
+    (F(5, 2), 1, "right_shoulder", arm_angles("right", "middle")),
+    (5, 2, "right_shoulder", np.zeros(3)),
+    (F(3, 2), F(3, 2), "left_shoulder", arm_angles("left_forward", "low")),
+    (2, 1, "neck", np.radians((-45.0, 0.0, 0.0))),  # rx < 0 tips an upright segment forward
+]
+EXPECTED = Score(
+    symbols=(
+        Symbol(1, 1, "right_arm", "forward", "middle"),
+        Symbol(2, F(1, 2), "right_arm", "forward", "high"),
+        Symbol(F(5, 2), 1, "right_arm", "right", "middle"),
+        Symbol(5, 2, "right_arm", "place", "low"),
+        Symbol(F(3, 2), F(3, 2), "left_arm", "left_forward", "low"),
+        Symbol(2, 1, "head", "forward", "high"),
+    ),
+    tempo=TEMPO,
+)
+
+
+def _gestures(score):
+    return Score(symbols=tuple(s for s in score.symbols if not s.is_support), tempo=score.tempo)
+
+
+@pytest.mark.parametrize("fps", [25.0, 30.0, 50.0])
+@pytest.mark.parametrize("effort", [(-2.0, 0.5), (-4.0, 0.35), (-2.4, 0.7)])
+def test_clean_motion_captures_exactly_its_symbols(fps, effort):
+    joints, _ = build_motion(MOVES, TEMPO, fps=fps, b=effort[0], x0=effort[1])
+    score = segment(joints, fps, tempo=TEMPO)
+    assert score_differences(EXPECTED, _gestures(score)) == []
+    # Standing still on both feet throughout: the starting pose, no support symbol.
+    assert not [s for s in score.symbols if s.is_support]
+
+
+def test_elbow_only_movement_is_a_forearm_symbol():
+    moves = [
+        (1, 1, "right_shoulder", arm_angles("forward", "middle")),
+        (3, 1, "right_elbow", np.radians((90.0, 0.0, 0.0))),
+    ]
+    joints, _ = build_motion(moves, 60)
+    score = _gestures(segment(joints, 25.0, tempo=60))
+    assert [(s.start, s.duration, s.part, s.direction, s.level) for s in score.symbols] == [
+        (1, 1, "right_arm", "forward", "middle", ),
+        (3, 1, "right_forearm", "place", "high"),
+    ]
+
+
+def test_bent_whole_arm_carries_its_bend_degree():
+    # Forward middle with the elbow bent 60°: the upper arm is lowered by the
+    # angle gamma between it and the shoulder → wrist line.
+    body = Body()
+    l1, l2 = body.segment_length("right_shoulder", "right_elbow"), body.segment_length("right_elbow", "right_wrist")
+    beta = np.radians(60.0)
+    gamma = np.arctan2(l2 * np.sin(beta), l1 + l2 * np.cos(beta))
+    moves = [(1, 1, "right_shoulder", (np.pi / 2 - gamma, 0, 0)), (1, 1, "right_elbow", (beta, 0, 0))]
+    joints, _ = build_motion(moves, 60)
+    (s,) = _gestures(segment(joints, 25.0, tempo=60)).symbols
+    assert (s.part, s.direction, s.level, s.bend, s.start, s.duration) == ("right_arm", "forward", "middle", 2, 1, 1)
+
+
+def test_noisy_motion_still_agrees():
+    rng = np.random.default_rng(7)
+    joints, _ = build_motion(MOVES, TEMPO)
+    noisy = joints + rng.normal(0.0, 0.008, joints.shape)  # 8 mm per coordinate
+    seg = segment_motion(noisy, 25.0, tempo=TEMPO)
+    a = compare_scores(EXPECTED, _gestures(seg.score), step=F(1, 4))
+    assert a.symbol_agreement >= 0.9
+    assert a.unmatched <= 1
+    assert a.median_start_error <= 0.25
+
+
+def test_estimated_tempo_recovers_the_written_one():
+    joints, _ = build_motion(MOVES, TEMPO)
+    seg = segment_motion(joints, 25.0)
+    assert seg.tempo_estimated
+    assert seg.tempo == TEMPO
+    assert score_differences(EXPECTED, _gestures(seg.score)) == []
+
+
+def test_key_frames_are_the_arrivals():
+    joints, _ = build_motion(MOVES, TEMPO)
+    seg = segment_motion(joints, 25.0, tempo=TEMPO)
+    spb = 60 / TEMPO
+    arrivals = sorted({round(float(s.end) * spb * 25) for s in EXPECTED.symbols})
+    assert seg.key_frames[0] == 0
+    for f in arrivals:
+        assert np.min(np.abs(seg.key_frames - f)) <= 1
+
+
+def test_movement_spans_hysteresis_and_split():
+    s = np.zeros(40)
+    s[5:10] = [1, 30, 60, 30, 1]  # one movement
+    s[20:31] = [2, 40, 80, 40, 5, 0.5, 5, 40, 80, 40, 2]  # two back to back
+    s[35] = 15  # a blip below the peak threshold
+    spans = movement_spans(s, low=3.0, high=20.0, split_ratio=0.35)
+    assert spans == [(5, 9), (20, 25), (26, 30)]
+
+
+def test_too_short_or_bad_input():
+    with pytest.raises(QuantiseError, match="at least 2 frames"):
+        segment(np.zeros((1, 21, 3)), 25.0, tempo=60)
+    joints, _ = build_motion(MOVES[:1], 60)
+    with pytest.raises(QuantiseError, match="tempo"):
+        segment(joints, 25.0, tempo=-3)
+
+
+def test_still_motion_gives_an_empty_score():
+    joints, _ = build_motion([(1, 1, "right_shoulder", np.zeros(3))], 60)
+    score = segment(joints, 25.0, tempo=60, params=SegmentParams())
+    assert score.symbols == ()
