@@ -26,9 +26,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from capture2notation.io.video import VideoWriter, iter_frames  # noqa: E402
-from capture2notation.keypoints import extract  # noqa: E402
-from capture2notation.keypoints.blazepose import BlazePose, crop_to_tensor  # noqa: E402
+from capture2notation.io.video import VideoWriter, iter_frames
+from capture2notation.keypoints import extract, extract_frames
+from capture2notation.keypoints.blazepose import BlazePose, crop_to_tensor
 
 FIXTURES = Path(os.environ.get("C2N_FIXTURES", ROOT.parent / "shared" / "fixtures"))
 
@@ -68,9 +68,9 @@ def bench_end_to_end(bp: BlazePose, size, n_frames: int, tmp: Path) -> None:
     t0 = time.perf_counter()
     n_decoded = sum(1 for _ in iter_frames(video))
     t_decode = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     track = extract(video, estimator=bp)
-    t_all = time.perf_counter() - t0
+    t_all, c_all = time.perf_counter() - t0, time.process_time() - c0
     frames = [f.image for f in iter_frames(video, stop=20)]
     t0 = time.perf_counter()
     for f in frames:
@@ -78,7 +78,7 @@ def bench_end_to_end(bp: BlazePose, size, n_frames: int, tmp: Path) -> None:
     t_crop = (time.perf_counter() - t0) / len(frames)
     print(
         f"end-to-end {size[0]}x{size[1]}: {len(track) / t_all:6.1f} fps "
-        f"({1000 * t_all / len(track):.1f} ms/frame over {len(track)} frames; "
+        f"({1000 * t_all / len(track):.1f} ms/frame wall, {1000 * c_all / len(track):.1f} ms/frame CPU, {len(track)} frames; "
         f"decode {1000 * t_decode / n_decoded:.1f} ms, crop+convert {1000 * t_crop:.2f} ms, "
         f"person found in {np.mean(track.presence > 0):.0%})"
     )
@@ -90,12 +90,17 @@ def bench_model(bp: BlazePose, n: int = 50) -> None:
     for _ in range(5):
         bp.session.run(None, {name: x})
     times = []
+    c0 = time.process_time()
     for _ in range(n):
         t0 = time.perf_counter()
         bp.session.run(None, {name: x})
         times.append(time.perf_counter() - t0)
+    cpu = 1000 * (time.process_time() - c0) / n
     t = 1000 * np.array(times)
-    print(f"model alone: median {np.median(t):.1f} ms/call (p10 {np.percentile(t, 10):.1f}, p90 {np.percentile(t, 90):.1f})")
+    print(
+        f"model alone: median {np.median(t):.1f} ms/call wall (p10 {np.percentile(t, 10):.1f}, "
+        f"p90 {np.percentile(t, 90):.1f}); {cpu:.1f} ms CPU/call; load average {os.getloadavg()[0]:.1f}"
+    )
 
 
 def bench_fixtures(bp: BlazePose) -> None:
@@ -121,10 +126,43 @@ def bench_fixtures(bp: BlazePose) -> None:
         )
 
 
+def bench_mannequin(bp: BlazePose, fps: float) -> None:
+    """PCK@5 % of person height per joint and left/right swaps on the built-in phrases."""
+    from capture2notation.body import Body
+    from capture2notation.keypoints.evaluate import PAIRS, left_right_swaps, pck, person_height_px
+    from synthetic import render
+    from synthetic.interpret import interpret
+    from synthetic.phrases import builtin_phrases
+
+    joints = [i for pair in PAIRS.values() for i in pair]
+    for view in ("front", "45", "side"):
+        hits, counts, swaps, n = {}, {}, dict.fromkeys(PAIRS, 0), 0
+        for name, score in sorted(builtin_phrases().items()):
+            pose = render.Pose.from_motion(interpret(score, fps, Body()))
+            cam = render.Camera.for_view(view, (640, 480), pose.body.height)
+            truth = render.truth_fields(pose, cam)
+            track = extract_frames(render.render_frames(pose, cam, "mannequin"), pose.fps, estimator=bp)
+            radius = 0.05 * person_height_px(cam.K, cam.R, cam.t, pose.root, pose.body.height)
+            vis = truth["visibility"] > 0
+            for j, v in pck(track.xy, truth["keypoints"], radius, vis, joints).items():
+                if np.isfinite(v):
+                    hits[j] = hits.get(j, 0.0) + v * vis[:, j].sum()
+                    counts[j] = counts.get(j, 0) + vis[:, j].sum()
+            for pair, frames in left_right_swaps(track.xy, truth["keypoints"], radius).items():
+                swaps[pair] += int(frames.sum())
+                if frames.any():
+                    print(f"  {view} {name}: {pair} swapped in frames {np.flatnonzero(frames).tolist()}")
+            n += len(track)
+        names = {i: f"{p}_{s}" for p, (left, right) in PAIRS.items() for s, i in (("L", left), ("R", right))}
+        row = " ".join(f"{names[j]}={hits[j] / counts[j]:.3f}" for j in joints if counts.get(j))
+        print(f"mannequin {view} ({n} frames at {fps:g} fps, visible joints): PCK@5% {row}; swaps {swaps}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=150, help="frames per rendered benchmark video")
     ap.add_argument("--threads", type=int, default=2, help="onnxruntime intra-op threads")
+    ap.add_argument("--mannequin-fps", type=float, default=10.0, help="frame rate of the mannequin accuracy renders (0: skip)")
     args = ap.parse_args()
     bp = BlazePose(threads=args.threads)
     print(f"onnxruntime threads: {args.threads}; cpu count: {os.cpu_count()}")
@@ -133,6 +171,8 @@ def main() -> None:
         for size in ((640, 480), (1280, 720)):
             bench_end_to_end(bp, size, args.frames, Path(tmp))
     bench_fixtures(bp)
+    if args.mannequin_fps > 0:
+        bench_mannequin(bp, args.mannequin_fps)
 
 
 if __name__ == "__main__":

@@ -214,7 +214,7 @@ def main(argv=None):
     ap.add_argument("--skip-recovery", action="store_true")
     ap.add_argument("--skip-emotion", action="store_true")
     a = ap.parse_args(argv)
-    n_perf, n_emo = (6, 6) if a.quick else (40, 40)
+    n_perf, n_emo = (6, 6) if a.quick else (40, 30)
     print(f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs (synthetic.interpret missing)'}")
     if not a.skip_recovery:
         recovery(n_perf, 1974, 0.0, a.workers)

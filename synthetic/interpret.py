@@ -9,8 +9,10 @@ Semantics (``../shared/DESIGN.md``; Wolofsky 1974 ch. IV; Neagle 2005 ch. 5):
   begins at the symbol's start frame and arrives at its end frame
   (``seconds = beats × 60 / tempo``, frame = round(seconds × fps)).
 * Progress along the path is the Effort logistic ``s(τ)`` (time b, weight
-  x0); the limb's frame turns about a fixed axis by ``s·θ``, so the
-  extremity covers the fraction ``s`` of its arc.  Space modulates the
+  x0): a whole limb's bound→free direction runs along the great circle (the
+  direct path) and covers the fraction ``s`` of its arc, its twist turning
+  uniformly with ``s`` too; segments and head/chest follow ``s`` the same
+  way.  Space modulates the
   extremity's distance from the bound joint mid-movement (Neagle eq. 5.5
   inward, or 5.6 outward when the limb is bent at both ends) by bending the
   middle joint.
@@ -46,7 +48,15 @@ from fractions import Fraction
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from capture2notation.body import JOINTS, Body, euler_to_matrix, joint_index, segment_vectors
+from capture2notation.body import (
+    JOINTS,
+    Body,
+    body_frame,
+    euler_to_matrix,
+    forward_kinematics,
+    joint_index,
+    segment_vectors,
+)
 from capture2notation.effort.model import progress, space_radius
 from capture2notation.errors import SyntheticError
 from capture2notation.notation.directions import bend_angle, bend_degree, canonical_vector, classify
@@ -66,6 +76,10 @@ PLIE_BEND_DEG = 45.0
 RELEVE_DEG = 35.0
 #: Height a stepping foot is lifted mid-step, fraction of body height.
 STEP_LIFT = 0.03
+#: Fraction of a support symbol by which a stepping or landing foot is down;
+#: the weight transfer takes the rest (Labanotation: the support symbol's
+#: length is the transference of weight).
+FOOT_ARRIVAL = 0.6
 
 _Z = np.array([0.0, 0.0, 1.0])
 # Limbs: name -> (whole part, upper part, lower part, bound, middle, free joint, sign).
@@ -99,14 +113,34 @@ def _rot_x(theta):
     return m
 
 
+def _cross(a, b):
+    a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+    return np.stack(
+        [a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+         a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]],
+        axis=-1,
+    )
+
+
 def _axis_angle(axis, angle):
-    return Rotation.from_rotvec(_unit(axis) * np.asarray(angle, dtype=float)[..., None]).as_matrix()
+    """Rotation matrices (Rodrigues) about `axis` (..., 3) by `angle` (...) radians."""
+    k = _unit(axis)
+    angle = np.asarray(angle, dtype=float)
+    k, angle = np.broadcast_arrays(k, angle[..., None])
+    angle = angle[..., 0]
+    c, s, x, y, z = np.cos(angle), np.sin(angle), k[..., 0], k[..., 1], k[..., 2]
+    t = 1.0 - c
+    m = np.empty(angle.shape + (3, 3))
+    m[..., 0, 0], m[..., 0, 1], m[..., 0, 2] = c + x * x * t, x * y * t - z * s, x * z * t + y * s
+    m[..., 1, 0], m[..., 1, 1], m[..., 1, 2] = y * x * t + z * s, c + y * y * t, y * z * t - x * s
+    m[..., 2, 0], m[..., 2, 1], m[..., 2, 2] = z * x * t - y * s, z * y * t + x * s, c + z * z * t
+    return m
 
 
 def _rot_between(a, b, fallback_axis):
     """Minimal rotation taking unit `a` to unit `b`; half turns about `fallback_axis`."""
     a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
-    v = np.cross(a, b)
+    v = _cross(a, b)
     c = np.sum(a * b, axis=-1)
     n = np.linalg.norm(v, axis=-1)
     angle = np.arctan2(n, c)
@@ -134,6 +168,39 @@ def _slerp_frames(Pa, Pb, s, prefer=None):
         if mid @ prefer < 0:
             rv = -rv
     return Rotation.from_rotvec(np.asarray(s)[:, None] * rv).as_matrix() @ Pa
+
+
+def _great_circle_frames(Pa, Pb, s, prefer):
+    """Frames whose −z runs along the great circle from `Pa`'s to `Pb`'s at progress `s`.
+
+    The limb takes the direct (shortest) path, covering the fraction `s` of
+    the arc, while its twist about itself turns uniformly with `s` too.  When
+    the end directions are opposite, the path passes through `prefer`.
+
+    Parameters
+    ----------
+    Pa, Pb : (3, 3) ndarray
+    s : (n,) ndarray
+    prefer : (3,) ndarray
+
+    Returns
+    -------
+    (n, 3, 3) ndarray
+    """
+    da, db = Pa @ -_Z, Pb @ -_Z
+    n = np.cross(da, db)
+    theta = np.arctan2(np.linalg.norm(n), da @ db)
+    if np.linalg.norm(n) < 1e-9:
+        n = np.cross(da, prefer)
+        if np.linalg.norm(n) < 1e-9:
+            n = Pa[:, 0]
+    G = _axis_angle(n, theta)
+    tw = (G @ Pa).T @ Pb  # a turn about the limb's own axis
+    psi = np.arctan2(tw[1, 0], tw[0, 0])
+    s = np.asarray(s, float)
+    return _axis_angle(np.broadcast_to(n, s.shape + (3,)), s * theta) @ Pa @ _axis_angle(
+        np.broadcast_to(_Z, s.shape + (3,)), s * psi
+    )
 
 
 def _slerp_dirs(da, db, s):
@@ -221,7 +288,7 @@ def _apply_move(limb: _Limb, Q, beta, f0: int, f1: int, syms, eff: Effort, hold_
     s = progress(tau, eff.time, eff.weight)
     if whole:
         Pa, Pb = limb.whole_frame(Qa, ba), limb.whole_frame(Qb, bb)
-        P = _slerp_frames(Pa, Pb, s, limb.prefer)
+        P = _great_circle_frames(Pa, Pb, s, limb.prefer)
         r = limb.radius(ba + s * (bb - ba))
         # Space: bend the middle joint so the reach follows eq. 5.5 (5.6 when
         # the limb is bent at both ends and so can reach out).
@@ -320,8 +387,8 @@ def _trunk_angles(d, body: Body):
     iw, ic = joint_index("waist"), joint_index("chest")
     lw, lc = body.limits[iw], body.limits[ic]
     o1, o2 = body.offsets[ic], body.offsets[joint_index("neck")]
-    axis = np.cross(_Z, uniq)
-    # Straight down has no tilt axis; bow forward (about +x... i.e. −x).
+    axis = _cross(_Z, uniq)
+    # Straight down has no tilt axis: bow forward (a turn about −x).
     axis[np.linalg.norm(axis, axis=-1) < 1e-9] = [-1.0, 0.0, 0.0]
     axis = _unit(axis)
     target = np.arccos(np.clip(uniq[:, 2], -1, 1))
@@ -374,6 +441,18 @@ def _planted_after(sup, ges, beat) -> bool:
     effects = [(s.end, 0, True) for s in sup if s.end <= beat]
     effects += [(g.start, 1, False) for g in ges if g.start <= beat]
     return max(effects)[2] if effects else True
+
+
+def _foot_progress(tau, eff: Effort):
+    """Progress of a stepping or landing foot over frames at `tau` (n,).
+
+    The foot is on the floor and still by τ = FOOT_ARRIVAL, and at the
+    latest one frame before the symbol's end, so it reads as supporting.
+    """
+    tau = np.asarray(tau, float)
+    arrive = min(FOOT_ARRIVAL, 1.0 - 1.0 / max(len(tau), 1)) if len(tau) > 1 else 1.0
+    s = progress(np.minimum(tau / max(arrive, 1e-9), 1.0), eff.time, eff.weight)
+    return s * s * (3.0 - 2.0 * s)
 
 
 def _weight_feet(sups, events, beat) -> list:
@@ -433,9 +512,9 @@ class _Support:
             f0, f1 = frame(s.start), frame(s.end)
             n = np.arange(f0 + 1, f1 + 1)
             tau = (n - f0) / max(f1 - f0, 1)
-            sp = progress(tau, self.eff.time, self.eff.weight)
-            # The foot itself comes to rest on arrival, so it reads as supporting.
-            sf = sp * sp * (3.0 - 2.0 * sp)
+            # The foot arrives (and comes to rest) within the first part of
+            # the symbol; the transfer of weight takes the whole of it.
+            sf = _foot_progress(tau, self.eff)
             for foot in _SUPPORT_FEET[s.part]:
                 sup, ges = self.events[foot]
                 planted = _planted_after(sup, ges, s.start)
@@ -476,8 +555,14 @@ class _Support:
             fa = max(f0, last_key)
             m = np.arange(fa + 1, f1 + 1)
             if f1 > fa:
-                sr = progress((m - fa) / (f1 - fa), self.eff.time, self.eff.weight)
-                sr = sr * sr * (3.0 - 2.0 * sr)  # the weight arrives settled
+                tau = (m - fa) / (f1 - fa)
+                if s.direction != "place":
+                    # A step: the pelvis arrives over the new support with the
+                    # foot, which it must do to put the foot down on a straight leg.
+                    sr = _foot_progress(tau, self.eff)
+                else:
+                    sr = progress(tau, self.eff.time, self.eff.weight)
+                    sr = sr * sr * (3.0 - 2.0 * sr)  # the weight arrives settled
                 ra = self.root[fa].copy()
                 self.root[m] = ra + sr[:, None] * (key - ra)
             self.root[f1:] = key
@@ -515,15 +600,24 @@ class _Support:
         """
         limb = self.limbs[foot]
         hip = (self.root + self.hip_off[foot])[frames]
-        ankle_pos = self.ankle[foot][frames] if ankle_pos is None else ankle_pos
+        ankle_pos = (self.ankle[foot][frames] if ankle_pos is None else ankle_pos).copy()
         foot_R = _rot_x(self.pitch[foot][frames]) if foot_R is None else foot_R
-        v = ankle_pos - hip
-        l = np.linalg.norm(v, axis=-1)
-        beta = limb.bend_for_radius(np.minimum(l, limb.reach))
-        Q = limb.upper_frame(limb.swing(v / l[:, None]), beta)
-        shin = Q @ _rot_x(limb.middle_angle(beta))
         ja = joint_index(f"{foot}_ankle")
-        ankle = euler_near(shin.transpose(0, 2, 1) @ foot_R, 0.0, self.body.limits[ja])
+        lim = self.body.limits[ja]
+        toe = self.body.offsets[joint_index(f"{foot}_toe")]
+        for _ in range(4):
+            v = ankle_pos - hip
+            l = np.linalg.norm(v, axis=-1)
+            beta = limb.bend_for_radius(np.minimum(l, limb.reach))
+            Q = limb.upper_frame(limb.swing(v / l[:, None]), beta)
+            shin = Q @ _rot_x(limb.middle_angle(beta))
+            ankle = np.clip(euler_near(shin.transpose(0, 2, 1) @ foot_R, 0.0, lim), lim[:, 0], lim[:, 1])
+            # Past the ankle's extremes (a plié with the feet far apart) the
+            # foot cannot stay flat: the heel lifts so the toe stays on the floor.
+            deficit = self.toe0 - (ankle_pos + (shin @ euler_to_matrix(ankle)) @ toe)[:, 2]
+            if not np.any(deficit > 1e-6):
+                break
+            ankle_pos[:, 2] += np.maximum(deficit, 0.0)
         return Q, beta, ankle
 
 
@@ -549,8 +643,7 @@ def _leg_tracks(sup: _Support, symbols, frame, T: int, eff: Effort):
         hip = sup.root + sup.hip_off[foot]
         for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []:
             g = run[0] - 1
-            w = progress(np.arange(1, run.size + 1) / run.size, eff.time, eff.weight)
-            w = w * w * (3.0 - 2.0 * w)  # the landing foot comes to rest
+            w = _foot_progress(np.arange(1, run.size + 1) / run.size, eff)
             shin_g = Qg[g] @ _rot_x(limb.middle_angle(bg[g]))
             a_g = hip[g] + Qg[g] @ sup.body.offsets[limb.joints[1]] + shin_g @ sup.body.offsets[limb.joints[2]]
             F_g = shin_g @ euler_to_matrix(ankle_g[g])
@@ -705,16 +798,18 @@ def unreachable(motion: Motion) -> list:
     gest = [(s, f1) for s, _, f1 in motion.events if not s.is_support]
     if not gest:
         return []
-    J = motion.joints()
+    frames = np.array([f1 for _, f1 in gest])
+    Jf = forward_kinematics(motion.angles[frames], motion.root[frames], motion.body)
+    frame = body_frame(Jf)
     out = []
-    for sym, f1 in gest:
+    for i, (sym, f1) in enumerate(gest):
         a, b = PART_SEGMENTS[sym.part]
-        v = segment_vectors(J[f1 : f1 + 1], a, b)[0]
+        v = segment_vectors(Jf[i : i + 1], a, b, frame[i : i + 1])[0]
         d, lv = classify(v)
         bend = sym.bend
         if sym.part in PART_MIDDLE_JOINT:
             m = joint_index(PART_MIDDLE_JOINT[sym.part])
-            bend = int(bend_degree(bend_angle(J[f1, joint_index(a)], J[f1, m], J[f1, joint_index(b)])))
+            bend = int(bend_degree(bend_angle(Jf[i, joint_index(a)], Jf[i, m], Jf[i, joint_index(b)])))
         if (d, lv, bend) != (sym.direction, sym.level, sym.bend):
             out.append((sym, (d, lv, bend)))
     return out

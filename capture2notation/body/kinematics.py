@@ -29,19 +29,24 @@ def euler_to_matrix(angles: np.ndarray) -> np.ndarray:
         ``Rz(rz) @ Ry(ry) @ Rx(rx)``.
     """
     a = np.asarray(angles, dtype=float)
-    cx, cy, cz = np.cos(a[..., 0]), np.cos(a[..., 1]), np.cos(a[..., 2])
-    sx, sy, sz = np.sin(a[..., 0]), np.sin(a[..., 1]), np.sin(a[..., 2])
     m = np.empty(a.shape[:-1] + (3, 3))
-    m[..., 0, 0] = cz * cy
-    m[..., 0, 1] = cz * sy * sx - sz * cx
-    m[..., 0, 2] = cz * sy * cx + sz * sx
-    m[..., 1, 0] = sz * cy
-    m[..., 1, 1] = sz * sy * sx + cz * cx
-    m[..., 1, 2] = sz * sy * cx - cz * sx
-    m[..., 2, 0] = -sy
-    m[..., 2, 1] = cy * sx
-    m[..., 2, 2] = cy * cx
+    _fill_rotation(m, a[..., 0], a[..., 1], a[..., 2], lambda m, i, k: m[..., i, k])
     return m
+
+
+def _fill_rotation(m, rx, ry, rz, entry):
+    """Write the entries of ``Rz @ Ry @ Rx`` into `m`; ``entry(m, i, k)`` is the (i, k) view."""
+    cx, cy, cz = np.cos(rx), np.cos(ry), np.cos(rz)
+    sx, sy, sz = np.sin(rx), np.sin(ry), np.sin(rz)
+    entry(m, 0, 0)[...] = cz * cy
+    entry(m, 0, 1)[...] = cz * sy * sx - sz * cx
+    entry(m, 0, 2)[...] = cz * sy * cx + sz * sx
+    entry(m, 1, 0)[...] = sz * cy
+    entry(m, 1, 1)[...] = sz * sy * sx + cz * cx
+    entry(m, 1, 2)[...] = sz * sy * cx - cz * sx
+    entry(m, 2, 0)[...] = -sy
+    entry(m, 2, 1)[...] = cy * sx
+    entry(m, 2, 2)[...] = cy * cx
 
 
 def matrix_to_euler(m: np.ndarray) -> np.ndarray:
@@ -69,6 +74,23 @@ def matrix_to_euler(m: np.ndarray) -> np.ndarray:
     return np.stack([rx, ry, rz], axis=-1)
 
 
+def _global_soa(angles: np.ndarray, body: Body) -> np.ndarray:
+    """World rotations laid out (J, 3, 3, T): frames last, so that composing
+    along the tree is elementwise arithmetic on long contiguous rows (far
+    faster than stacks of tiny 3×3 matrix products)."""
+    a = angles.transpose(1, 2, 0)  # (J, 3, T)
+    local = np.empty((a.shape[0], 3, 3, a.shape[2]))
+    _fill_rotation(local, a[:, 0], a[:, 1], a[:, 2], lambda m, i, k: m[:, i, k])
+    glob = np.empty_like(local)
+    for j, p in enumerate(body.parents):
+        if p < 0:
+            glob[j] = local[j]
+        else:
+            g, l = glob[p], local[j]
+            glob[j] = g[:, 0, None, :] * l[0] + g[:, 1, None, :] * l[1] + g[:, 2, None, :] * l[2]
+    return glob
+
+
 def global_rotations(angles: np.ndarray, body: Body | None = None) -> np.ndarray:
     """World orientation of every joint's local frame.
 
@@ -84,11 +106,7 @@ def global_rotations(angles: np.ndarray, body: Body | None = None) -> np.ndarray
     (T, J, 3, 3) ndarray
     """
     body = body or Body()
-    local = euler_to_matrix(_check(angles))
-    glob = np.empty_like(local)
-    for j, p in enumerate(body.parents):
-        glob[:, j] = local[:, j] if p < 0 else glob[:, p] @ local[:, j]
-    return glob
+    return np.ascontiguousarray(np.moveaxis(_global_soa(_check(angles), body), -1, 0))
 
 
 def forward_kinematics(
@@ -123,14 +141,14 @@ def forward_kinematics(
         raise BodyModelError(
             f"root_position must have shape ({T}, 3) to match angles, got {root_position.shape}"
         )
-    glob = global_rotations(angles, body)
-    pos = np.empty((T, len(JOINTS), 3))
-    pos[:, 0] = root_position
+    glob = _global_soa(angles, body)  # (J, 3, 3, T)
+    pos = np.empty((len(JOINTS), 3, T))
+    pos[0] = root_position.T
     offsets = body.offsets
     for j in range(1, len(JOINTS)):
-        p = body.parents[j]
-        pos[:, j] = pos[:, p] + glob[:, p] @ offsets[j]
-    return pos
+        g, o = glob[body.parents[j]], offsets[j]
+        pos[j] = pos[body.parents[j]] + g[:, 0] * o[0] + g[:, 1] * o[1] + g[:, 2] * o[2]
+    return np.ascontiguousarray(pos.transpose(2, 0, 1))
 
 
 def _check(angles: np.ndarray) -> np.ndarray:

@@ -33,7 +33,7 @@ _RIGHT_REST: dict[str, tuple[str, tuple[float, float, float]]] = {
     "thumb": ("wrist", (0.112, 0.030, 0.428)),
     "heel": ("ankle", (0.055, -0.030, 0.008)),
 }
-_NOSE = ("neck", (0.0, 0.071, 0.911))  # the tip stands ~1.5 cm proud of the skull
+_NOSE = ("neck", (0.0, 0.063, 0.913))
 
 
 def _attachments() -> dict[str, tuple[str, tuple[float, float, float]]]:

@@ -57,6 +57,31 @@ class SpaceEstimate:
     amplitude_se: float
 
 
+def _truncnorm_summary(mu: float, sd: float, lo: float, hi: float, mass: float = 0.9):
+    """Median and highest-density `mass` interval of N(mu, sd²) truncated to [lo, hi].
+
+    The highest-density interval reaches the bound when the mode sits on it
+    (an equal-tailed interval would then exclude the most probable values).
+    """
+    dist = stats.truncnorm((lo - mu) / sd, (hi - mu) / sd, loc=mu, scale=sd)
+    if not np.isfinite(dist.ppf(0.5)):  # all mass far beyond one end
+        v = float(np.clip(mu, lo, hi))
+        return v, v, v
+    mode = float(np.clip(mu, lo, hi))
+    # widen a symmetric-in-density window [mode - h, mode + h] ∩ [lo, hi]
+    h_lo, h_hi = 0.0, hi - lo
+    for _ in range(60):
+        h = 0.5 * (h_lo + h_hi)
+        a, b = max(mu - h, lo), min(mu + h, hi)
+        if mode in (lo, hi):
+            a, b = (lo, min(lo + h, hi)) if mode == lo else (max(hi - h, lo), hi)
+        if dist.cdf(b) - dist.cdf(a) < mass:
+            h_lo = h
+        else:
+            h_hi = h
+    return float(a), float(dist.ppf(0.5)), float(b)
+
+
 def _check(tau, y, weight):
     tau = np.asarray(tau, dtype=float)
     y = np.asarray(y, dtype=float)
@@ -113,10 +138,11 @@ def fit_logistic(tau, s, weight=None, sd_floor_sigma: float = 1e-4) -> LogisticF
 
 
 def fit_space(tau, radial, weight=None) -> SpaceEstimate:
-    """Space from the radial deviation: ``radial ≈ A·sin(πτ)``, ``S = 1 + A / 0.1``.
+    """Space from the radial deviation: ``radial ≈ c0 + c1·τ + A·sin(πτ)``, ``S = 1 − |A| / 0.1``.
 
     Eq. 5.5 pulls the extremity inward by ``(1 − S)·0.1·r·sin(πτ)``, so a
     direct movement (S = 1) has A = 0 and the most indirect one A = −0.1.
+    The straight-line terms absorb errors of the direct path's end radii.
     The uniform prior on S ∈ [0, 1] truncates the Gaussian posterior of A;
     an outward bulge (A > 0) is read by its size, as indirect as an inward
     one of the same depth.
@@ -129,18 +155,22 @@ def fit_space(tau, radial, weight=None) -> SpaceEstimate:
         Per-sample confidence.
     """
     tau, y, w = _check(tau, radial, weight)
-    x = np.sin(np.pi * tau)
-    sxx = np.sum(w * x * x)
-    amp = float(np.sum(w * x * y) / sxx)
-    resid = y - amp * x
-    dof = max(tau.size - 1, 1)
-    s2 = np.sum(w * resid**2) / dof
-    # floor: 3D positions are never better than ~1e-4 relative, and a
-    # noise-free render would otherwise give a zero-width interval
-    se = float(max(np.sqrt(s2 / sxx), 1e-4))
-    mu = 1.0 - abs(amp) / INWARD_DEPTH
+    if tau.size < 4:
+        raise EffortError(f"need at least 4 samples to fit Space, got {tau.size}")
+    x = np.column_stack([np.ones_like(tau), tau, np.sin(np.pi * tau)])
+    sw = np.sqrt(w)
+    coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
+    resid = y - x @ coef
+    s2 = np.sum(w * resid**2) / max(tau.size - 3, 1)
+    cov = np.linalg.pinv((x * w[:, None]).T @ x)
+    amp = float(coef[2])
+    # floor: the dancer's own modulation is resolved to ~1e-3 of the radius
+    # (S to 0.01); a noise-free render would otherwise give a zero-width interval
+    se = float(max(np.sqrt(s2 * cov[2, 2]), 1e-3))
+    # inward (eq. 5.5) is the model; a clear outward bulge (eq. 5.6, bent
+    # limbs) is read by its depth, but noise about zero stays signed so that
+    # a direct movement is not pushed below S = 1
+    mu = 1.0 - abs(amp) / INWARD_DEPTH if amp > 3.0 * se else 1.0 + amp / INWARD_DEPTH
     sd = se / INWARD_DEPTH
-    a, b = (0.0 - mu) / sd, (1.0 - mu) / sd
-    dist = stats.truncnorm(a, b, loc=mu, scale=sd)
-    lo, med, hi = (float(np.clip(q, 0.0, 1.0)) for q in dist.ppf([0.05, 0.5, 0.95]))
+    lo, med, hi = _truncnorm_summary(mu, sd, 0.0, 1.0)
     return SpaceEstimate(median=med, ci90=(lo, hi), amplitude=amp, amplitude_se=se)

@@ -78,10 +78,11 @@ def log_probability(theta, tau, s, weight, onehot=None):
         Data as in :func:`sample_posterior`.
     onehot : (N, G) ndarray, optional
         Movement membership of each sample.  When given, each movement's
-        observed progress is ``k_g · s(τ)`` with its own end scale ``k_g``
-        (flat prior), marginalised analytically: the progress is normalised
-        by the movement's noisy end point, which otherwise biases every
-        sample of the movement alike.  None: ``k = 1`` exactly.
+        observed progress is ``c_g + k_g · s(τ)`` with its own offset and end
+        scale (flat priors), marginalised analytically: progress is measured
+        from the movement's noisy start direction and normalised by its noisy
+        end, which otherwise shifts or stretches every sample of the movement
+        alike.  None: ``c = 0, k = 1`` exactly.
 
     Returns
     -------
@@ -107,19 +108,23 @@ def log_probability(theta, tau, s, weight, onehot=None):
         chi2 = np.sum(weight * (s - model) ** 2, axis=1)
         out[inside] = -0.5 * chi2 * np.exp(-2.0 * li) - tau.size * li
         return out
-    # Gaussian integral over each k_g: chi2 at the best k_g plus a log-det term
-    ws = weight * s
+    # Gaussian integral over each (c_g, k_g): chi2 at their best values plus
+    # the log-determinant of the 2x2 normal equations
     if onehot.shape[1] == 1:  # one movement: plain sums are faster than the product
-        ss = np.sum(ws * s)
-        sm = np.sum(ws * model, axis=1, keepdims=True)
-        mm = np.sum(weight * model * model, axis=1, keepdims=True)
+        def gsum(x):
+            return np.sum(x, axis=-1, keepdims=True)
     else:
-        ss = (ws * s) @ onehot  # (G,)
-        sm = (ws * model) @ onehot  # (W', G)
-        mm = (weight * model * model) @ onehot  # (W', G)
-    chi2 = np.sum(ss - sm * sm / mm, axis=1)
-    dof = tau.size - onehot.shape[1]
-    out[inside] = -0.5 * chi2 * np.exp(-2.0 * li) - dof * li - 0.5 * np.sum(np.log(mm), axis=1)
+        def gsum(x):
+            return x @ onehot
+    ws = weight * s
+    s0, s_s, s_ss = gsum(weight), gsum(ws), gsum(ws * s)  # (G,)
+    wm = weight * model
+    s_m, s_mm, s_sm = gsum(wm), gsum(wm * model), gsum(ws * model)  # (W', G)
+    det = s0 * s_mm - s_m * s_m
+    fit = (s_mm * s_s * s_s - 2.0 * s_m * s_s * s_sm + s0 * s_sm * s_sm) / det
+    chi2 = np.sum(s_ss - fit, axis=1)
+    dof = tau.size - 2 * onehot.shape[1]
+    out[inside] = -0.5 * chi2 * np.exp(-2.0 * li) - dof * li - 0.5 * np.sum(np.log(det), axis=1)
     return out
 
 
@@ -129,7 +134,7 @@ def sample_posterior(
     weight=None,
     rng: np.random.Generator | int | None = None,
     groups=None,
-    free_scale: bool = True,
+    free_ends: bool = True,
     nwalkers: int = 24,
     block: int = 100,
     max_steps: int = 6000,
@@ -150,9 +155,10 @@ def sample_posterior(
     groups : (N,) array_like of int, optional
         Movement index of each sample when several are pooled (default: one
         movement).
-    free_scale : bool
-        Give each movement a free end scale, marginalised analytically (see
-        :func:`log_probability`); False pins s(1) = 1 to the observed end.
+    free_ends : bool
+        Give each movement a free offset and end scale, marginalised
+        analytically (see :func:`log_probability`); False pins s(0) = 0 and
+        s(1) = 1 to the observed start and end.
     nwalkers : int
         Ensemble size (≥ 2 × 3 dimensions).
     block : int
@@ -189,7 +195,7 @@ def sample_posterior(
     p0[:, 2] = np.clip(p0[:, 2], LOG_SIGMA_RANGE[0] + 1e-3, LOG_SIGMA_RANGE[1] - 1e-3)
 
     onehot = None
-    if free_scale:
+    if free_ends:
         g = np.zeros(tau.size, dtype=int) if groups is None else np.asarray(groups)
         if g.shape != tau.shape:
             raise EffortError(f"groups must label each of the {tau.size} samples, got shape {g.shape}")

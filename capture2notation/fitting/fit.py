@@ -22,7 +22,8 @@ import numpy as np
 from ..body import JOINTS, Body, joint_index
 from ..errors import FittingError
 from .camera import DEFAULT_HFOV_DEG, Camera
-from .lengths import estimate_offsets
+from .ik import initial_angles
+from .lengths import offsets_from_ratios
 from .model import PoseModel
 from .result import FitResult
 from .solver import FitOptions, Terms, check_fps, fill, fill2, pelvis_axis, rewarm, solve, to_result
@@ -130,15 +131,40 @@ def _direction_terms(names, tc, tw):
     return pairs, np.stack(dirs, 1), np.stack(w, 1)
 
 
-def _world_offsets(names, tc, tw, body):
-    """Per-clip offsets from world landmarks (MediaPipe's are metric)."""
-    pts = np.full((tc.shape[0], _J, 3), np.nan)
-    conf = np.zeros((tc.shape[0], _J))
-    for i, name in enumerate(names):
-        if name in JOINTS:
-            pts[:, joint_index(name)] = tw[:, i]
-            conf[:, joint_index(name)] = tc[:, i]
-    return estimate_offsets(pts, conf, body)
+def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body) -> np.ndarray:
+    """Per-clip proportions from the image lengths of the segments.
+
+    A segment's image length, turned into metres at its depth, is its true
+    length when it lies parallel to the image.  With world landmarks, the
+    frames where they say so (depth component under 0.25 of the length) give
+    the median length, at the segment's own depth (pelvis depth + landmark
+    depth); without, the 90th percentile over the clip does.  Only the
+    proportions are kept (``relative=True`` in
+    :func:`~capture2notation.fitting.lengths.offsets_from_ratios`), so the
+    lengths agree with where the keypoint model puts its landmarks (a BlazePose
+    ankle sits above our ankle joint) while the size stays the body's.
+    """
+    model0 = PoseModel(body)
+    depth = camera.to_camera(_initial_params(model0, camera, names, tx, tc, None)[:, :3])[:, 2]
+    ratio = np.full(_J, np.nan)
+    base = np.linalg.norm(body.offsets, axis=1)
+    for j, name in enumerate(JOINTS):
+        p = body.parents[j]
+        if p < 0 or name not in names or JOINTS[p] not in names or base[j] <= 0:
+            continue
+        a, b = names.index(JOINTS[p]), names.index(name)
+        ok = (tc[:, a] >= 0.5) & (tc[:, b] >= 0.5)
+        z = depth
+        if tw is not None:
+            d = tw[:, b] - tw[:, a]
+            flat = np.abs(d[:, 2]) < 0.25 * np.linalg.norm(d, axis=1)
+            z = depth + 0.5 * (tw[:, a, 2] + tw[:, b, 2])
+            ok &= flat & np.isfinite(z)
+        if ok.sum() < 3:
+            continue
+        metres = np.linalg.norm(tx[ok, b] - tx[ok, a], axis=1) * z[ok] / camera.focal
+        ratio[j] = (np.median(metres) if tw is not None else np.percentile(metres, 90)) / base[j]
+    return offsets_from_ratios(ratio, body, relative=True)
 
 
 def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw) -> np.ndarray:
@@ -186,6 +212,18 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw) -> np.ndar
         yaw = np.where(flip, yaw + np.pi, yaw)
     yaw = np.unwrap(fill(yaw, fallback=0.0))
     params[:, 3 + pelvis_axis(model, 2)] = yaw
+    if tw is not None:
+        # World landmarks give 3D directions: start from their closed-form pose.
+        pts = np.full((T, _J, 3), np.nan)
+        for i, name in enumerate(names):
+            if name in JOINTS:
+                pts[:, joint_index(name)] = np.where((tc[:, i] > 0)[:, None], tw[:, i] @ cam.R, np.nan)
+        ang = initial_angles(pts, model)
+        have = np.all(np.isfinite(pts[:, [joint_index("right_hip"), joint_index("left_hip")]]), axis=(1, 2))
+        ang[~have, 0] = 0.0
+        ang[~have, 0, 2] = yaw[~have]
+        ang[:, 0] = np.unwrap(ang[:, 0], axis=0)  # the pelvis turns freely: keep it continuous
+        params[:, 3:] = ang[:, model.dof_joint, model.dof_axis]
     return params
 
 
@@ -354,7 +392,7 @@ def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions):
         Targets with a reprojection term.
     """
     names, tx, tc, tw = _targets_from_landmarks(xy, conf, world, opt)
-    offsets = _world_offsets(names, tc, tw, body) if tw is not None else body.offsets
+    offsets = _image_offsets(names, tx, tc, tw, camera, body)
     model = PoseModel(body, offsets)
     w_targets = np.array([t[2] for t in TARGETS_2D])
     use2 = w_targets > 0

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..body import JOINTS, Body, joint_index
+from ..body import JOINTS, Body
 from ..errors import FittingError
+from .ik import initial_angles
 from .lengths import estimate_offsets
 from .model import PoseModel
 from .result import FitResult
-from .solver import FitOptions, Terms, check_fps, fill, fill2, pelvis_axis, rewarm, solve, to_result
+from .solver import FitOptions, Terms, check_fps, fill2, rewarm, solve, to_result
 
 __all__ = ["fit_points3d"]
 
@@ -82,9 +83,9 @@ def fit_points3d(points, confidence, fps: float, body: Body | None = None, times
     params0 = np.zeros((points.shape[0], model.n_params))
     pel = points[:, 0]
     params0[:, :3] = fill2(pel, fallback=body.rest[0])
-    r, l = points[:, joint_index("right_hip")], points[:, joint_index("left_hip")]
-    yaw = np.arctan2((r - l)[:, 1], (r - l)[:, 0])
-    params0[:, 3 + pelvis_axis(model, 2)] = np.unwrap(fill(yaw, 0.0))
+    ang = initial_angles(np.where((conf > 0)[..., None], points, np.nan), model)
+    ang[:, 0] = np.unwrap(ang[:, 0], axis=0)  # the pelvis turns freely: keep it continuous
+    params0[:, 3:] = ang[:, model.dof_joint, model.dof_axis]
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
     params, cost = rewarm(model, params, cost, terms, fps, opt)
     usable = np.sum(conf >= opt.min_confidence, axis=1) >= min(opt.min_targets, 4)

@@ -16,7 +16,7 @@ import numpy as np
 from ..body import JOINTS, Body
 from ..errors import FittingError
 
-__all__ = ["estimate_offsets", "scale_of"]
+__all__ = ["estimate_offsets", "offsets_from_ratios", "scale_of"]
 
 _MIN_FRAMES = 3
 _MIN_CONF = 0.5
@@ -24,7 +24,13 @@ _MIN_CONF = 0.5
 _RATIO_BAND = (0.5, 2.0)
 
 
-def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | None = None) -> np.ndarray:
+#: With ``relative=True`` a segment may differ from the model's proportion by
+#: at most this factor (keypoint models' world landmarks are not exact).
+RELATIVE_BAND = (0.85, 1.15)
+
+
+def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | None = None,
+                     relative: bool = False) -> np.ndarray:
     """Per-clip joint offsets from measured 3D joint positions.
 
     Parameters
@@ -37,6 +43,11 @@ def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | No
         Per-point confidence in [0, 1]; below 0.5 a point is not used.
     body : Body, optional
         Model proportions (default ``Body()``).
+    relative : bool
+        Keep the body's overall size (its height) and take only the
+        proportions from the data, each within :data:`RELATIVE_BAND`: for
+        sources whose scale is unreliable (BlazePose world landmarks come out
+        up to ~20 % small, and a wrong size turns into a wrong depth).
 
     Returns
     -------
@@ -60,13 +71,34 @@ def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | No
         both = ok[:, j] & ok[:, p]
         if both.sum() < _MIN_FRAMES or base[j] <= 0:
             continue
-        r = np.median(np.linalg.norm(points[both, j] - points[both, p], axis=1)) / base[j]
-        if _RATIO_BAND[0] <= r <= _RATIO_BAND[1]:
-            ratio[j] = r
+        ratio[j] = np.median(np.linalg.norm(points[both, j] - points[both, p], axis=1)) / base[j]
+    return offsets_from_ratios(ratio, body, relative)
+
+
+def offsets_from_ratios(ratio: np.ndarray, body: Body | None = None, relative: bool = False) -> np.ndarray:
+    """Offsets from measured length ratios to the model (NaN = not measured).
+
+    Parameters
+    ----------
+    ratio : (J,) ndarray
+        Measured length of the segment ending at each joint over the model's.
+    body : Body, optional
+    relative : bool
+        See :func:`estimate_offsets`.
+
+    Returns
+    -------
+    (J, 3) ndarray
+    """
+    body = body or Body()
+    ratio = np.asarray(ratio, float).copy()
+    ratio[~((ratio >= _RATIO_BAND[0]) & (ratio <= _RATIO_BAND[1]))] = np.nan
     ratio = _symmetrise(ratio)
     measured = ratio[np.isfinite(ratio)]
     overall = float(np.median(measured)) if measured.size else 1.0
     ratio = np.where(np.isfinite(ratio), ratio, overall)
+    if relative:
+        ratio = np.clip(ratio / overall, *RELATIVE_BAND)
     ratio[0] = 0.0
     return body.offsets * ratio[:, None]
 

@@ -62,7 +62,7 @@ class FitOptions:
     """
 
     sigma_2d: float = 0.02
-    sigma_dir: float = 0.12
+    sigma_dir: float = 0.18
     sigma_3d: float = 0.02
     sigma_smooth: float = 0.08
     sigma_rest: float = 1.5
@@ -184,8 +184,35 @@ def _prior_precision(model: PoseModel, fps: float, opt: FitOptions, T: int):
     return smooth, rest
 
 
+#: Frames solved in one batch (memory ~ 0.1 MB per frame), and the overlap
+#: between batches that keeps the temporal term continuous across them.
+CHUNK, OVERLAP = 400, 16
+
+
 def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
-           iterations: int) -> tuple[np.ndarray, np.ndarray]:
+          iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """Solve long clips in overlapping chunks of :data:`CHUNK` frames; see :func:`solve_batch`."""
+    T = params.shape[0]
+    if T <= CHUNK:
+        return solve_batch(model, params, terms, fps, opt, iterations)
+    out = np.empty_like(params)
+    cost = np.empty(T)
+    start = 0
+    while start < T:
+        a = max(0, start - OVERLAP)
+        b = min(T, start + CHUNK)
+        init = params[a:b].copy()
+        init[: start - a] = out[a:start]  # warm start from the previous chunk
+        p, c = solve_batch(model, init, _subset(terms, slice(a, b)), fps, opt, iterations)
+        # Keep the chunk's frames from `start` on; its first OVERLAP frames only
+        # gave the temporal term context.
+        out[start:b], cost[start:b] = p[start - a :], c[start - a :]
+        start = b
+    return out, cost
+
+
+def solve_batch(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
+                iterations: int) -> tuple[np.ndarray, np.ndarray]:
     """Vectorised Levenberg–Marquardt over all frames; returns (params, data cost per frame).
 
     The first two thirds of the iterations use a hundredth of the temporal
@@ -223,7 +250,7 @@ def rewarm(model, params, cost, terms, fps, opt, ratio=3.0, iterations=8):
     for t in flagged:  # only the few frames stuck in a poor local minimum
         if cost[t] <= ratio * max(cost[t - 1], 1.0):
             continue
-        p1, c1 = solve(model, params[t - 1 : t].copy(), _subset(terms, slice(t, t + 1)), fps, opt, iterations)
+        p1, c1 = solve_batch(model, params[t - 1 : t].copy(), _subset(terms, slice(t, t + 1)), fps, opt, iterations)
         if c1[0] < cost[t]:
             params[t], cost[t] = p1[0], c1[0]
     return params, cost

@@ -36,7 +36,7 @@ from ..errors import MotionFileError
 from .atomic import write_text
 
 __all__ = ["BvhSkeleton", "NAME_TABLE", "parse_bvh", "bvh_positions", "map_joints", "read_bvh_points",
-           "read_own_bvh", "write_bvh"]
+           "read_own_bvh", "write_bvh", "write_motion_bvh"]
 
 log = logging.getLogger(__name__)
 
@@ -515,6 +515,14 @@ def write_bvh(path, angles: np.ndarray, root: np.ndarray, fps: float, offsets: n
     lines += ["MOTION", f"Frames: {T}", f"Frame Time: {1.0 / fps:.8f}"]
     lines += [" ".join(f"{v:.6f}" for v in row) for row in data]
     return write_text(path, "\n".join(lines) + "\n")
+
+
+def write_motion_bvh(path, motion, unit: str = "cm") -> Path:
+    """Write a :class:`~capture2notation.fitting.FitResult` (or ``MotionData``) as BVH.
+
+    Uses its ``angles``, ``root``, ``fps`` and per-clip ``offsets``; see :func:`write_bvh`.
+    """
+    return write_bvh(path, motion.angles, motion.root, motion.fps, offsets=motion.offsets, unit=unit)
 
 
 def _dfs(children, j):

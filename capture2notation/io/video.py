@@ -14,6 +14,7 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import cv2
 import numpy as np
@@ -22,13 +23,13 @@ from ..errors import VideoError
 from .atomic import atomic_path
 
 __all__ = [
-    "VIDEO_EXTENSIONS",
     "IMAGE_EXTENSIONS",
+    "VIDEO_EXTENSIONS",
     "Frame",
     "VideoInfo",
-    "probe",
-    "iter_frames",
     "VideoWriter",
+    "iter_frames",
+    "probe",
 ]
 
 VIDEO_EXTENSIONS = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm")
@@ -242,7 +243,7 @@ class VideoWriter:
     ...     w.write(frame)
     """
 
-    _FOURCC = {".avi": "MJPG", ".mp4": "mp4v", ".mov": "mp4v", ".m4v": "mp4v"}
+    _FOURCC: ClassVar[dict[str, str]] = {".avi": "MJPG", ".mp4": "mp4v", ".mov": "mp4v", ".m4v": "mp4v"}
 
     def __init__(self, path, fps: float, size: tuple[int, int]):
         self.path = Path(path)

@@ -11,9 +11,9 @@ from .track import LANDMARK_NAMES, NUM_LANDMARKS, KeypointTrack, landmark_index
 
 __all__ = [
     "BACKENDS",
-    "KeypointTrack",
     "LANDMARK_NAMES",
     "NUM_LANDMARKS",
+    "KeypointTrack",
     "extract",
     "extract_frames",
     "landmark_index",

@@ -30,17 +30,17 @@ import numpy as np
 from ..errors import KeypointError, ModelError
 from .filter import AUX_FILTER, POSE_FILTER, VISIBILITY_ALPHA, WORLD_FILTER, LowPass, OneEuroFilter, object_scale
 from .heatmap import refine_from_heatmap
-from .model import INPUT_SHAPE, resolve_model
+from .model import INPUT_SHAPE, OUTPUT_SHAPES, resolve_model
 
 __all__ = [
-    "PoseEstimate",
     "BlazePose",
-    "make_session",
-    "full_frame_crop",
+    "PoseEstimate",
     "crop_from_aux",
     "crop_matrix",
     "crop_to_tensor",
     "decode_outputs",
+    "full_frame_crop",
+    "make_session",
 ]
 
 logger = logging.getLogger(__name__)
@@ -49,6 +49,7 @@ INPUT_SIZE = INPUT_SHAPE[-1]
 NUM_ALL = 39  # 33 body landmarks + aux 33, 34 + 4 unused
 ROI_SCALE = 1.25  # RectTransformationCalculator scale_x/scale_y in PoseLandmarksToRoi
 PRESENCE_THRESHOLD = 0.5  # ThresholdingCalculator in the pose graph
+MIN_CROP_PX = 16.0  # smaller crops are upsampled noise: re-acquire instead
 
 
 @dataclass
@@ -108,12 +109,22 @@ def make_session(model=None, threads: int = 2):
     opts.inter_op_num_threads = 1
     opts.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
     # Full graph optimisation fuses Conv+Clip and roughly halves the run time
-    # against the basic level; building it takes < 0.1 s, so no cached copy.
+    # against the basic level; building it takes < 0.1 s (pruning ~0.3 s), so
+    # an optimised copy is not cached.
     opts.graph_optimization_level = ort.GraphOptimizationLevel.ORT_ENABLE_ALL
     try:
-        return ort.InferenceSession(pruned, opts, providers=["CPUExecutionProvider"])
+        session = ort.InferenceSession(pruned, opts, providers=["CPUExecutionProvider"])
     except Exception as exc:  # onnxruntime raises untyped errors
         raise ModelError(f"{path}: onnxruntime cannot load the pose model: {exc}") from exc
+    expected = [OUTPUT_SHAPES[i] for i in (0, 1, 3, 4)]
+    got = [tuple(o.shape) for o in session.get_outputs()]
+    inputs = [tuple(i.shape) for i in session.get_inputs()]
+    if got != expected or inputs != [INPUT_SHAPE]:
+        raise ModelError(
+            f"{path}: not the BlazePose full landmark model: inputs {inputs}, outputs {got}; "
+            f"expected input {INPUT_SHAPE} and outputs {OUTPUT_SHAPES}"
+        )
+    return session
 
 
 def full_frame_crop(width: int, height: int) -> np.ndarray:
@@ -143,6 +154,11 @@ def crop_from_aux(aux: np.ndarray, scale: float = ROI_SCALE) -> np.ndarray:
     rotation = np.pi / 2 - np.arctan2(-(y1 - y0), x1 - x0)
     rotation = rotation - 2 * np.pi * np.floor((rotation + np.pi) / (2 * np.pi))
     return np.array([x0, y0, side, side, rotation])
+
+
+def _usable(crop: np.ndarray) -> bool:
+    """A crop worth running the model on: finite and at least MIN_CROP_PX wide."""
+    return bool(np.isfinite(crop).all() and crop[2] >= MIN_CROP_PX)
 
 
 def _rotation(theta: float) -> np.ndarray:
@@ -232,6 +248,8 @@ class BlazePose:
         Reuse an existing session (the model is then not resolved again).
     """
 
+    backend = "blazepose"
+
     def __init__(
         self,
         model=None,
@@ -268,9 +286,10 @@ class BlazePose:
             raise KeypointError(f"expected a BGR image (H, W, 3), got shape {image.shape}")
         est = self.infer(image, full_frame_crop(image.shape[1], image.shape[0]))
         for _ in range(self.refinements):
-            if est.presence < self.presence_threshold:
+            crop = crop_from_aux(est.aux)
+            if est.presence < self.presence_threshold or not _usable(crop):
                 break
-            est = self.infer(image, crop_from_aux(est.aux))
+            est = self.infer(image, crop)
         return est
 
     def process(self, image: np.ndarray, t: float) -> PoseEstimate | None:
@@ -309,5 +328,6 @@ class BlazePose:
                 est.aux = self._f_aux(t, est.aux, 1.0 / aux_scale)
             est.world = self._f_world(t, est.world)
             est.visibility = self._f_vis(est.visibility)
-        self._crop = crop_from_aux(est.aux)
+        crop = crop_from_aux(est.aux)
+        self._crop = crop if _usable(crop) else None  # else re-acquire next frame
         return est

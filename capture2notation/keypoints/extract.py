@@ -82,7 +82,6 @@ def extract_frames(
     if hasattr(est, "smooth"):
         est.smooth = bool(smooth)
     est.reset()
-    name = "markers" if type(est).__name__ == "MarkerTracker" else "blazepose"
     times, xy, vis, pres, world, crops = [], [], [], [], [], []
     size = None
     for i, item in enumerate(frames):
@@ -119,7 +118,7 @@ def extract_frames(
         presence=np.array(pres),
         world=np.array(world),
         crops=np.array(crops),
-        backend=name,
+        backend=est.backend,
     )
 
 

@@ -17,13 +17,13 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
-    "OneEuroFilter",
-    "LowPass",
-    "object_scale",
-    "POSE_FILTER",
     "AUX_FILTER",
-    "WORLD_FILTER",
+    "POSE_FILTER",
     "VISIBILITY_ALPHA",
+    "WORLD_FILTER",
+    "LowPass",
+    "OneEuroFilter",
+    "object_scale",
 ]
 
 #: (min_cutoff Hz, beta, derivative cutoff Hz) for the 33 image landmarks.

@@ -106,7 +106,7 @@ def detect_blobs(mask: np.ndarray, min_area: int = 4, max_blobs: int = 8) -> tup
     areas : (N,) ndarray
         Pixel counts, largest first.
     """
-    n, _labels, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    _n, _labels, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
     areas = stats[1:, cv2.CC_STAT_AREA]
     keep = np.flatnonzero(areas >= min_area)
     keep = keep[np.argsort(-areas[keep])][:max_blobs]
@@ -127,6 +127,8 @@ class MarkerTracker:
         when the colour is shared; farther blobs only claim markers that
         have no history.
     """
+
+    backend = "markers"
 
     def __init__(self, markers=None, min_area: int = 4, max_jump: float = 80.0):
         self.markers = list(default_markers() if markers is None else markers)

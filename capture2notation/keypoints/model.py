@@ -37,20 +37,20 @@ from ..errors import ModelError
 from ..io.atomic import atomic_path, write_text
 
 __all__ = [
+    "INPUT_SHAPE",
     "MEDIAPIPE_VERSION",
+    "OUTPUT_SHAPES",
     "TFLITE_MEMBER",
     "TFLITE_SHA256",
-    "INPUT_SHAPE",
-    "OUTPUT_SHAPES",
     "cache_dir",
     "cached_model_path",
     "cached_tflite_path",
-    "resolve_model",
-    "fetch_model",
     "convert_tflite",
-    "verify_onnx",
+    "fetch_model",
     "patched_tflite2onnx",
+    "resolve_model",
     "sha256_file",
+    "verify_onnx",
 ]
 
 logger = logging.getLogger(__name__)
@@ -335,7 +335,25 @@ def convert_tflite(tflite_path, onnx_path) -> Path:
         raise ModelError(f"tflite2onnx could not convert {tflite_path}: {type(exc).__name__}: {exc}") from exc
     finally:
         t2o_log.setLevel(level)
+    _canonicalise(onnx_path)
     return onnx_path
+
+
+def _canonicalise(onnx_path: Path) -> None:
+    """Sort initializers and value infos by name, in place.
+
+    tflite2onnx collects them in Python sets, so their order (and the file's
+    sha256) changes from run to run; sorted, every conversion of the same
+    TFLite file gives the same bytes, and concurrent fetches agree.
+    """
+    import onnx
+
+    model = onnx.load(str(onnx_path))
+    for field in (model.graph.initializer, model.graph.value_info):
+        items = sorted(field, key=lambda x: x.name)
+        del field[:]
+        field.extend(items)
+    onnx.save(model, str(onnx_path))
 
 
 def verify_onnx(path) -> None:

@@ -14,7 +14,7 @@ import numpy as np
 from ..errors import KeypointError
 from ..io.atomic import atomic_path
 
-__all__ = ["KeypointTrack", "LANDMARK_NAMES", "NUM_LANDMARKS", "landmark_index"]
+__all__ = ["LANDMARK_NAMES", "NUM_LANDMARKS", "KeypointTrack", "landmark_index"]
 
 #: The 33 BlazePose landmarks in model order (nose = 0 … right_foot_index = 32).
 LANDMARK_NAMES: tuple[str, ...] = (
@@ -140,9 +140,8 @@ class KeypointTrack:
         arrays = {name: getattr(self, name) for name in _FIELDS}
         arrays["backend"] = np.array(self.backend)
         arrays["names"] = np.array(self.names)
-        with atomic_path(path, suffix=".npz") as tmp:
-            with open(tmp, "wb") as f:  # a file object stops numpy appending ".npz"
-                np.savez_compressed(f, **arrays)
+        with atomic_path(path, suffix=".npz") as tmp, open(tmp, "wb") as f:  # a file object stops numpy appending ".npz"
+            np.savez_compressed(f, **arrays)
         return path
 
     @classmethod

@@ -11,7 +11,8 @@ Layout (Hutchinson's conventions, as in Wolofsky 1974 ch. III):
   (then thigh and shin when the score uses them), body (chest, drawn on the
   right), arm (then upper arm and forearm when used), and the head column
   outside the right arm.  ``support`` (both feet) spans both support columns;
-* direction shapes: place a rectangle; forward/back a rectangle with a
+* direction shapes (stems and slants placed as in LabanotationSuite's
+  LabanEditor viewer): place a rectangle; forward/back a rectangle with a
   step-shaped stem at the top/bottom on the side towards the centre line;
   right/left a triangle pointing sideways (a trapezoid when long); the four
   diagonals a rectangle with a slanted top (forward) or bottom (back) edge

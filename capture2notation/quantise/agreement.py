@@ -3,7 +3,8 @@
 Two scores can say the same thing in different words, so both are first put
 in a normal form (:func:`normalise`): a gesture symbol that moves a part to
 where it already is (its default standing pose or its previous destination)
-changes nothing and is dropped; so is a support symbol that keeps the same
+changes nothing and is dropped; an upper-arm and a forearm (thigh and shin)
+symbol over the same span pointing the same way are the straight whole limb; so is a support symbol that keeps the same
 feet at the same level in place.  The support parts (``support``,
 ``right_support``, ``left_support``) form one column, ``supports``, whose
 state is (part, direction, level).
@@ -47,12 +48,36 @@ DEFAULT_STATE.update({"head": ("place", "high", 0), "chest": ("place", "high", 0
 DEFAULT_SUPPORT = ("support", "place", "middle")
 
 
+_SEGMENTS = {
+    "right_arm": ("right_upper_arm", "right_forearm"),
+    "left_arm": ("left_upper_arm", "left_forearm"),
+    "right_leg": ("right_thigh", "right_shin"),
+    "left_leg": ("left_thigh", "left_shin"),
+}
+
+
+def _join_straight_limbs(symbols) -> list:
+    """Upper and lower segment symbols over one span, both the same way: a straight whole limb."""
+    syms = list(symbols)
+    index = {(s.start, s.duration, s.part): s for s in syms}
+    drop, add = set(), []
+    for limb, (up, low) in _SEGMENTS.items():
+        for s in syms:
+            if s.part != up:
+                continue
+            t = index.get((s.start, s.duration, low))
+            if t is not None and (t.direction, t.level) == (s.direction, s.level):
+                drop |= {id(s), id(t)}
+                add.append(Symbol(s.start, s.duration, limb, s.direction, s.level, 0))
+    return [s for s in syms if id(s) not in drop] + add
+
+
 def normalise(score: Score) -> Score:
     """The normal form of `score` used for comparison (see module docstring)."""
     state = dict(DEFAULT_STATE)
     out: list[Symbol] = []
     support = DEFAULT_SUPPORT
-    for s in score.symbols:
+    for s in sorted(_join_straight_limbs(score.symbols), key=Symbol.sort_key):
         if s.is_support:
             key = (s.part, s.direction, s.level)
             if s.direction == "place" and key == support:
@@ -64,6 +89,13 @@ def normalise(score: Score) -> Score:
         if state.get(s.part) == key:
             continue
         state[s.part] = key
+        # A limb's whole and segment states follow each other only when straight.
+        for limb, (up, low) in _SEGMENTS.items():
+            if s.part == limb:
+                seg = key if s.bend == 0 else None
+                state[up], state[low] = seg, seg
+            elif s.part in (up, low):
+                state[limb] = None
         out.append(s)
     return Score(symbols=tuple(out), title=score.title, tempo=score.tempo, meter=score.meter)
 

@@ -35,7 +35,8 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ..errors import QuantiseError
-from ..notation.model import LEVELS, Score, Symbol
+from ..body import joint_index
+from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
 from .labels import DIRECTION_NAMES, FrameLabels, label_frames
 from .supports import support_movements
 from .tempo import estimate_tempo, snap
@@ -136,6 +137,10 @@ _FOOT = {"right_leg": 0, "left_leg": 1}
 #: Speeds below this (degrees per second) are rounding noise of a hold, not
 #: movement; a sudden Effort's first frame still moves far more.
 _ZERO_SPEED = 1e-6
+#: Jitter (degrees per frame) below which motion counts as clean (the
+#: virtual dancer's truth measures ≤ 0.02°, optical mocap ≥ 0.1°): not
+#: smoothed, and split only at exactly written poses.
+_CLEAN_NOISE_DEG = 0.05
 
 
 def _angle_deg(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -148,16 +153,18 @@ def _angle_deg(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 def _noise_deg(u: np.ndarray) -> float:
     """Frame-to-frame jitter of unit vectors (T, 3), degrees (robust; ~0 when clean).
 
-    The residual from a local cubic (Savitzky–Golay, 5 frames) is tiny for
-    smooth motion, however fast, and about 0.72 σ for white noise of σ per
-    coordinate; its median ignores the few kinks where movements start or stop.
+    The residual from a local cubic (Savitzky–Golay, 5 frames) is zero in a
+    hold and small in smooth motion, but white noise of σ per tangent
+    coordinate leaves a Rayleigh-distributed residual of scale 0.72 σ.  Its
+    lower quartile (0.55 σ for noise) ignores the kinks of sudden movements,
+    which are never more than a fraction of the frames.
     """
     ok = np.isfinite(u).all(axis=-1)
     if ok.sum() < 7:
         return 0.0
     v = u[ok]
     r = np.linalg.norm(v - savgol_filter(v, 5, 3, axis=0), axis=-1)
-    return float(np.degrees(np.median(r)) / 0.72)
+    return float(np.degrees(np.percentile(r, 25)) / 0.55)
 
 
 def _smooth(u: np.ndarray, window: int) -> np.ndarray:
@@ -178,7 +185,9 @@ def _smooth(u: np.ndarray, window: int) -> np.ndarray:
     return s
 
 
-def movement_spans(speed: np.ndarray, low: float, high: float, split_ratio: float) -> list[tuple[int, int]]:
+def movement_spans(
+    speed: np.ndarray, low: float, high: float, split_ratio: float, key_pose=None
+) -> list[tuple[int, int]]:
     """Movements in a per-interval speed signal.
 
     Parameters
@@ -191,6 +200,12 @@ def movement_spans(speed: np.ndarray, low: float, high: float, split_ratio: floa
         above `high`.
     split_ratio : float
         See :class:`SegmentParams`.
+    key_pose : callable, optional
+        ``key_pose(frame, since) -> bool`` with attribute ``on_grid`` (see
+        :func:`_key_pose_fn`).  When given (clean motion), a run is split at
+        the local speed minima it accepts, however shallow, and never
+        elsewhere — a limb passing near its turning axis slows down
+        mid-movement without arriving anywhere.
 
     Returns
     -------
@@ -217,8 +232,47 @@ def movement_spans(speed: np.ndarray, low: float, high: float, split_ratio: floa
         while b < n - 1 and _ZERO_SPEED < s[b + 1] <= s[b] and not above[b + 1]:
             b += 1
         taken[a : b + 1] = True
-        spans.extend(_split(s, a, b, split_ratio, high))
+        if key_pose is None:
+            spans.extend(_split(s, a, b, split_ratio, high))
+        else:
+            spans.extend(_split_at_key_poses(s, a, b, low, key_pose))
     return spans
+
+
+def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> list[tuple[int, int]]:
+    """Split [a, b] where the motion passes a written pose.
+
+    With a beat grid every grid frame accepted by ``key_pose`` is a boundary;
+    without, only such frames next to a local speed minimum (a minimum in
+    interval m puts the boundary at frame m, the next movement's first
+    interval, or m + 1, this movement's last).
+    """
+    cuts = []
+    if key_pose.on_grid:
+        for f in range(a + 1, b + 1):
+            if key_pose(f, cuts[-1] if cuts else a):
+                cuts.append(f)
+    else:
+        for m in range(a + 1, b):
+            if not (s[m] <= s[m - 1] and s[m] <= s[m + 1]):
+                continue
+            for f in (m, m + 1):
+                if a < f <= b and (not cuts or f > cuts[-1]) and key_pose(f, cuts[-1] if cuts else a):
+                    cuts.append(f)
+                    break
+    bounds = [a] + cuts + [b + 1]
+    out = []
+    start = None
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        start = lo if start is None else start
+        # A slow-starting movement (a sudden Effort) stays on its start pose
+        # for a few frames: those pieces belong to the movement that follows.
+        if s[lo:hi].max() > low:
+            out.append((start, hi - 1))
+            start = None
+    if start is not None and out:
+        out[-1] = (out[-1][0], b)
+    return out
 
 
 def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float) -> list[tuple[int, int]]:
@@ -243,29 +297,51 @@ def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float) -> list[tup
     return _split(s, a, m, ratio, high) + _split(s, m + 1, b, ratio, high)
 
 
-def _thresholds(u_list: list[np.ndarray], fps: float, params: SegmentParams, smoothed: bool) -> tuple[float, float]:
-    noise = max(_noise_deg(u) for u in u_list)
-    # Jitter of σ degrees per frame gives speeds of order σ·fps (less after smoothing).
-    noise_speed = noise * fps * (0.35 if smoothed else 1.0)
-    low = max(params.min_speed_deg_s, params.noise_k * noise_speed)
-    high = max(params.peak_speed_deg_s, 2.0 * low)
-    return low, high
-
-
-def _window(u_list: list[np.ndarray], fps: float, params: SegmentParams) -> int:
-    if params.smooth_s is not None:
-        w = int(round(params.smooth_s * fps))
-    else:
-        # Clean motion (jitter below a tenth of a degree) is left alone so
-        # movement boundaries stay on their frames.
-        noisy = max(_noise_deg(u) for u in u_list) > 0.1
-        w = int(round(0.2 * fps)) if noisy else 0
-    return w + (1 - w % 2) if w > 0 else 0
-
-
-def _interval_speed(u_list: list[np.ndarray], fps: float) -> np.ndarray:
-    per = [_angle_deg(u[:-1], u[1:]) for u in u_list]
+def _interval_speed(u_list: list[np.ndarray], x_list: list[np.ndarray], fps: float) -> np.ndarray:
+    """Largest angular speed of the vectors and rate of the scalars over each interval, degrees per second."""
+    per = [_angle_deg(u[:-1], u[1:]) for u in u_list] + [np.abs(np.diff(x)) for x in x_list]
     return np.nanmax(np.stack(per), axis=0) * fps if per[0].size else np.zeros(0)
+
+
+def _scalar_noise(x: np.ndarray) -> float:
+    """Jitter of a scalar series (degrees), as :func:`_noise_deg`."""
+    x = x[np.isfinite(x)]
+    if x.size < 7:
+        return 0.0
+    # Lower quartile of |N(0, 0.72 σ)| is 0.23 σ.
+    return float(np.percentile(np.abs(x - savgol_filter(x, 5, 3)), 25) / 0.23)
+
+
+def _smooth_scalar(x: np.ndarray, window: int) -> np.ndarray:
+    if window < 5 or x.size <= window or not np.isfinite(x).all():
+        return x
+    return savgol_filter(x, window, 2)
+
+
+def _channel(labels: FrameLabels, joints: np.ndarray, part: str) -> tuple[list, list, list]:
+    """Signals whose change is a movement of `part`.
+
+    Returns
+    -------
+    vectors : list of (T, 3) ndarray
+        The part's bound → free unit vector.
+    reach : list of (T,) ndarray
+        Limbs: bound-to-free distance over the straight limb's length, as an
+        angle in degrees (radians × 180/π).  It follows the extremity
+        smoothly, whereas the bend angle — and the segments — swing at
+        unbounded speed as a limb straightens under the Space modulation.
+    bend : list of (T,) ndarray
+        Limbs: the bend β in degrees.
+    """
+    vec = [labels.vectors[:, labels.index(part)]]
+    if part not in _LIMBS:
+        return vec, [], []
+    a, b = PART_SEGMENTS[part]
+    m = PART_MIDDLE_JOINT[part]
+    ja, jm, jb = joints[:, joint_index(a)], joints[:, joint_index(m)], joints[:, joint_index(b)]
+    full = np.nanmedian(np.linalg.norm(jm - ja, axis=-1)) + np.nanmedian(np.linalg.norm(jb - jm, axis=-1))
+    reach = np.linalg.norm(jb - ja, axis=-1) / full
+    return vec, [np.degrees(reach)], [labels.bend_deg[:, labels.index(part)]]
 
 
 def segment_motion(
@@ -304,20 +380,24 @@ def segment_motion(
     if T < 2:
         raise QuantiseError(f"need at least 2 frames to segment a motion, got {T}")
     joints = np.asarray(joints, dtype=float)
-    moves = _gesture_movements(labels, fps, params) + support_movements(labels, joints, fps, params, movement_spans)
-    moves.sort(key=lambda m: (m.start_time, m.part))
-    times = np.array([t for m in moves for t in (m.start_time, m.end_time)])
+    supports = support_movements(labels, joints, fps, params, movement_spans)
     estimated = tempo is None
-    if estimated and len(moves) == 0:
-        # Nothing moves: the (empty) score needs some tempo; say so, invent nothing else.
-        warnings.warn("no movement found: the tempo cannot be estimated, writing 60 bpm", stacklevel=2)
-        tempo, estimated = Fraction(60), False
     if estimated:
-        gestures = [m.end_time - m.start_time for m in moves if not m.part.endswith("support")]
-        tempo = estimate_tempo(times, params.grid, durations=gestures or None)
+        moves = _gesture_movements(labels, joints, fps, params) + supports
+        times = np.array([t for m in moves for t in (m.start_time, m.end_time)])
+        if len(moves) == 0:
+            # Nothing moves: the (empty) score needs some tempo; say so, invent nothing else.
+            warnings.warn("no movement found: the tempo cannot be estimated, writing 60 bpm", stacklevel=2)
+            tempo, estimated = Fraction(60), False
+        else:
+            gestures = [m.end_time - m.start_time for m in moves if not m.part.endswith("support")]
+            tempo = estimate_tempo(times, params.grid, durations=gestures or None)
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
     if tempo <= 0:
         raise QuantiseError(f"tempo must be > 0 beats per minute, got {tempo}")
+    # With the beat grid known, clean motion is cut only on its frames.
+    moves = _gesture_movements(labels, joints, fps, params, _grid_frames(T, fps, tempo, params.grid)) + supports
+    moves.sort(key=lambda m: (m.start_time, m.part))
     merged = _merge_times(moves, params, float(tempo))
     symbols = _symbols(merged, tempo, params.grid)
     key_frames = np.unique(np.r_[0, [min(m.end_frame, T - 1) for m in moves]].astype(int))
@@ -355,37 +435,163 @@ def _off_canonical_deg(labels: FrameLabels, col: int, frames: slice) -> float:
     return float(_angle_deg(v / np.linalg.norm(v), c))
 
 
-def _upper_written(labels: FrameLabels, upper: int, whole: int, frames: slice, tol: float = 2.0) -> bool:
-    """True when the upper segment, not the whole limb, ends on a canonical direction.
+def _off_canonical_series(v: np.ndarray) -> np.ndarray:
+    """Angle from each vector (T, 3) to the canonical vector of its own label, degrees."""
+    from ..notation.directions import canonical_vector, classify_indices
 
-    A whole-limb symbol puts the bound → free vector exactly on its canonical
-    vector; an upper-arm / thigh symbol puts the upper segment there instead.
-    Noisy motion rarely meets either, and then the whole limb is written.
+    d, lv = classify_indices(v)
+    table = np.full((len(DIRECTION_NAMES), len(LEVELS), 3), np.nan)
+    for i, name in enumerate(DIRECTION_NAMES):
+        for k, level in enumerate(LEVELS):
+            if not (name == "place" and level == "middle"):
+                table[i, k] = canonical_vector(name, level)
+    c = table[np.clip(d, 0, None), np.clip(lv, 0, None)]
+    out = _angle_deg(v, c)
+    return np.where((d < 0) | ~np.isfinite(out), np.inf, out)
+
+
+def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = None, tol: float = 0.05,
+                 min_change: float = 5.0):
+    """``(f, since) -> bool``: frame f can end a movement.
+
+    The part must be exactly where some symbol would put it, f must be a
+    grid frame (when `on_grid` is given: the frame a renderer gives a grid
+    time), and the pose must be at least `min_change` degrees from its pose
+    at frame `since` (a movement arrives somewhere new).  A limb sweeping
+    through a written direction mid-movement rarely does all of these."""
+    cols = [labels.index(part)] + [labels.index(p) for p in _LIMBS.get(part, ())]
+    if part in _LIMBS:
+        whole = _off_canonical_series(labels.vectors[:, cols[0]])
+        bend = labels.bend_deg[:, cols[0]]
+        bend_ok = np.abs(bend - 30.0 * np.round(bend / 30.0)) < tol
+        up, low = (_off_canonical_series(labels.vectors[:, c]) for c in cols[1:])
+        ok = ((whole < tol) & bend_ok) | ((up < tol) & (low < tol))
+    else:
+        bend = None
+        ok = _off_canonical_series(labels.vectors[:, cols[0]]) < tol
+    if on_grid is not None:
+        ok = ok & on_grid
+
+    def key(f: int, since: int) -> bool:
+        if not ok[f]:
+            return False
+        change = max(float(_angle_deg(labels.vectors[f, c], labels.vectors[since, c])) for c in cols)
+        if bend is not None:
+            change = max(change, abs(float(bend[f] - bend[since])))
+        return change >= min_change
+
+    key.on_grid = on_grid is not None
+    return key
+
+
+def _noise_speed(noise: float, fps: float, window: int) -> float:
+    """Speed (deg/s) that jitter of `noise` degrees per frame exceeds 1 % of the
+    time after Savitzky–Golay smoothing over `window` frames (measured on
+    simulated jitter: 2.0, 1.25, 0.95 × noise × fps for windows 5, 7, 9)."""
+    w = max(window, 1)
+    c = 2.0 * (5.0 / w) ** 1.4 if w >= 5 else 4.0
+    return c * noise * fps
+
+
+def _smoothing_window(noise: float, fps: float, params: SegmentParams) -> int:
+    """Odd smoothing window, frames: none for clean motion, else ≥ 0.3 s and
+    widened (up to 0.6 s) until jitter stays below about 15°/s."""
+    if params.smooth_s is not None:
+        w = int(round(params.smooth_s * fps))
+    elif noise <= _CLEAN_NOISE_DEG:
+        # Clean motion is left alone so movement boundaries stay on their frames.
+        return 0
+    else:
+        w = max(5, int(round(0.3 * fps)))
+        while w < 0.6 * fps and _noise_speed(noise, fps, w) > 15.0:
+            w += 2
+    return w + (1 - w % 2) if w > 0 else 0
+
+
+def _grid_frames(T: int, fps: float, tempo: Fraction, grid: Fraction) -> np.ndarray:
+    """(T,) bool: frames nearest to a grid time (round half up, as a renderer times a beat)."""
+    step = float(grid) * 60.0 / float(tempo) * fps  # frames per grid step
+    k = np.arange(int(np.ceil((T - 1) / step)) + 2)
+    f = np.floor(k * step + 0.5 + 1e-9).astype(int)
+    out = np.zeros(T, bool)
+    out[f[f < T]] = True
+    return out
+
+
+def _limb_symbols(labels: FrameLabels, part: str, start_f: int, end_f: int, frames: slice,
+                  params: SegmentParams, clean: bool):
+    """Segment symbols for a limb movement, or None when the whole limb is written.
+
+    The whole limb is written (with its bend) unless the segments move
+    independently: the upper segment stays still while the lower one moves
+    (a forearm / shin symbol), or — clean motion only — the bent limb arrives
+    with both segments on written directions (upper-arm and forearm symbols
+    over the same span; a whole-limb symbol with a bend puts the upper
+    segment off the written directions except by coincidence).
+
+    Returns
+    -------
+    list of (part, direction, level) or None
     """
-    return _off_canonical_deg(labels, upper, frames) < tol and _off_canonical_deg(labels, whole, frames) > 2 * tol
+    whole = labels.index(part)
+    upper, lower = (labels.index(p) for p in _LIMBS[part])
+    u = labels.vectors[:, upper]
+    d2, lv2, _ = _label_at(labels, lower, frames)
+    if not d2 or (d2 == "place" and lv2 == "middle"):
+        return None
+    if float(_angle_deg(u[start_f], u[end_f])) < 0.5 * params.min_amplitude_deg:
+        return [(_LIMBS[part][1], d2, lv2)]
+    if not clean:
+        return None
+    tol = 0.05
+    bend = float(np.nanmean(labels.bend_deg[frames, whole]))
+    # A bent whole limb almost never has both segments on written directions,
+    # so two written segments mean the segments were written.
+    if bend < tol or _off_canonical_deg(labels, upper, frames) >= tol or _off_canonical_deg(labels, lower, frames) >= tol:
+        return None
+    d1, lv1, _ = _label_at(labels, upper, frames)
+    return [(_LIMBS[part][0], d1, lv1), (_LIMBS[part][1], d2, lv2)]
 
 
-def _gesture_movements(labels: FrameLabels, fps: float, params: SegmentParams) -> list[Movement]:
+def _gesture_movements(
+    labels: FrameLabels, joints: np.ndarray, fps: float, params: SegmentParams, on_grid: np.ndarray | None = None
+) -> list[Movement]:
     out: list[Movement] = []
     T = labels.direction.shape[0]
     hold = max(1, int(round(0.1 * fps)))
     for part in tuple(_LIMBS) + _SINGLE:
-        cols = [labels.index(p) for p in _LIMBS.get(part, (part,))]
         whole = labels.index(part)
-        u_list = [labels.vectors[:, c] for c in cols]
-        w = _window(u_list, fps, params)
+        u_list, reach, bend_list = _channel(labels, joints, part)
+        noise = max([_noise_deg(u) for u in u_list] + [_scalar_noise(x) for x in bend_list])
+        clean = params.smooth_s is None and noise <= _CLEAN_NOISE_DEG
+        # Clean motion: the smooth reach, split at written poses only; noisy
+        # motion: the bend itself (smoothed), split at deep speed minima.
+        x_list = reach if clean else bend_list
+        w = _smoothing_window(noise, fps, params)
         if w:
             u_list = [_smooth(u, w) for u in u_list]
-        low, high = _thresholds(u_list, fps, params, bool(w))
-        speed = _interval_speed(u_list, fps)
-        spans = movement_spans(speed, low, high, params.split_ratio)
+            x_list = [_smooth_scalar(x, w) for x in x_list]
+        if clean:
+            # Without noise a hold is exactly still, so any motion belongs to a
+            # movement (the Space modulation can nearly stop one mid-way);
+            # written poses, not thresholds, separate movements.
+            low, high = 100 * _ZERO_SPEED, 200 * _ZERO_SPEED
+        else:
+            low = max(params.min_speed_deg_s, _noise_speed(noise, fps, w))
+            high = max(params.peak_speed_deg_s, 2.0 * low)
+        speed = _interval_speed(u_list, x_list, fps)
+        key = _key_pose_fn(labels, part, on_grid) if clean else None
+        spans = movement_spans(speed, low, high, params.split_ratio, key_pose=key)
         state = _DEFAULT.get(part, ("place", "low")) + (0,)
         for i, (a, b) in enumerate(spans):
             start_f, end_f = a, min(b + 1, T - 1)
             nxt = spans[i + 1][0] if i + 1 < len(spans) else T
-            frames = slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))
-            moved = [float(_angle_deg(u[start_f], u[end_f])) for u in u_list]
-            if np.nanmax(moved) < params.min_amplitude_deg:
+            # Clean motion is exactly on its pose at the arrival frame; noisy
+            # motion is averaged over the following hold.
+            frames = slice(end_f, end_f + 1) if clean else slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))
+            moved = max([float(_angle_deg(u[start_f], u[end_f])) for u in u_list]
+                        + [abs(float(x[end_f] - x[start_f])) for x in bend_list])
+            if not moved >= params.min_amplitude_deg:
                 continue
             if part in _FOOT and labels.supporting[end_f, _FOOT[part]]:
                 # A leg that arrives on the floor is a support, not a gesture.
@@ -393,28 +599,14 @@ def _gesture_movements(labels: FrameLabels, fps: float, params: SegmentParams) -
                 continue
             # The movement leaves frame a's pose and arrives at frame b + 1's.
             t0, t1 = a / fps, (b + 1) / fps
-            if part in _LIMBS and moved[0] < params.min_amplitude_deg:
-                # Upper segment still, lower one moving: segments move independently.
-                lower = cols[1]
-                d, lv, _ = _label_at(labels, lower, frames)
-                if d:
-                    out.append(Movement(_LIMBS[part][1], start_f, end_f, t0, t1, d, lv, 0))
+            if part in _LIMBS:
+                segs = _limb_symbols(labels, part, start_f, end_f, frames, params, clean)
+                if segs is not None:
+                    out.extend(Movement(p, start_f, end_f, t0, t1, d, lv, 0) for p, d, lv in segs)
                     state = ("", "", -1)
-                continue
+                    continue
             d, lv, bend = _label_at(labels, whole, frames)
             if not d or (d == "place" and lv == "middle"):
-                continue
-            if part in _LIMBS and bend > 0 and _upper_written(labels, cols[0], whole, frames):
-                # The upper segment, not the whole limb, arrives on a written
-                # direction: an upper-arm / thigh symbol (the lower one carried).
-                d, lv, _ = _label_at(labels, cols[0], frames)
-                out.append(Movement(_LIMBS[part][0], start_f, end_f, t0, t1, d, lv, 0))
-                bends = labels.bend_deg[[start_f, end_f], whole]
-                if abs(bends[1] - bends[0]) > 15.0:
-                    # The elbow / knee changed too: both segments notated over the span.
-                    d2, lv2, _ = _label_at(labels, cols[1], frames)
-                    out.append(Movement(_LIMBS[part][1], start_f, end_f, t0, t1, d2, lv2, 0))
-                state = ("", "", -1)
                 continue
             if part not in _LIMBS:
                 bend = 0

@@ -1,4 +1,4 @@
-"""``c2n render``: score → ``video.mp4`` + ``truth.npz`` + ``score.lab``."""
+"""``c2n render``: score → ``video.mp4`` (or PNG frames) + ``truth.npz`` + ``score.lab``."""
 
 from __future__ import annotations
 
@@ -46,7 +46,8 @@ def _fps(value: float) -> float:
 @click.option("--view", default="front", show_default=True, help="Camera: front, 45 or side.")
 @click.option("--style", default="mannequin", show_default=True, help="Drawing: mannequin, stick or markers.")
 @click.option("--emotion", default=None, help="Perform with an emotion preset: happy, sad, angry or afraid.")
-def render(score, outdir, fps, size, view, style, emotion):
+@click.option("--png", is_flag=True, help="Write the frames as OUTDIR/frames/frame_NNNNNN.png instead of video.mp4.")
+def render(score, outdir, fps, size, view, style, emotion, png):
     """Perform the notation in SCORE (.lab, .json, 1974 coded input) with the
     virtual dancer and render it with its ground truth."""
     from capture2notation.notation import EMOTIONS
@@ -59,5 +60,7 @@ def render(score, outdir, fps, size, view, style, emotion):
     check_choice(style, "--style", list(STYLES))
     check_choice(emotion, "--emotion", list(EMOTIONS))
     parsed = read(score)
-    out = render_score(parsed, outdir, fps=fps, size=wh, view=view, style=style, emotion=emotion, progress=True)
-    click.echo(f"{out}: video.mp4, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps)")
+    video = "frames" if png else "video.mp4"
+    out = render_score(parsed, outdir, fps=fps, size=wh, view=view, style=style, emotion=emotion, progress=True,
+                       video_name=video)
+    click.echo(f"{out}: {video}, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps)")

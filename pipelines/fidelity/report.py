@@ -102,15 +102,18 @@ def conclusions(table: list[dict], summary: dict) -> list[str]:
     for factor, name in names.items():
         levels = [t for t in table if t["factor"] == factor]
         if not levels:
+            if factor == "compression" and summary.get("capture") in ("truth", "keypoints"):
+                lines.append("Compression: not measured — this capture path has no images to compress.")
             continue
+        levels = _with_baseline(table, factor)
         measured = [t for t in levels if t["jobs"] > t["failed"]]
         if not measured:
-            lines.append(f"{name.capitalize()}: not measured on this capture path ({levels[0]['jobs']} jobs failed).")
+            lines.append(f"{name.capitalize()}: not measured ({levels[0]['jobs']} jobs failed).")
             continue
-        good = [t["condition"] for t in measured if ok(t)]
-        bad = [f"{t['condition']} (symbols {t['symbol_accuracy']:.0%}, observer {t['percent_correct']:.0f} %)"
+        good = [_level(t, factor) for t in measured if ok(t)]
+        bad = [f"{_level(t, factor)} (symbols {t['symbol_accuracy']:.0%}, observer {t['percent_correct']:.0f} %)"
                for t in measured if not ok(t)]
-        s = f"{name.capitalize()}: sufficient — {'; '.join(good) if good else 'none'}."
+        s = f"{name.capitalize()}: sufficient — {', '.join(good) if good else 'none of the levels tried'}."
         if bad:
             s += f" Not sufficient — {'; '.join(bad)}."
         lines.append(s)
@@ -211,9 +214,9 @@ def _figures(rep: Report, result, table) -> None:
         rep.figure(fig, "recovery_frame_rate", "Notation and Effort recovery against frame rate.")
     # Other factors.
     for factor, title in (("image_size", "image size"), ("view", "viewpoint"), ("compression", "compression"), ("noise", "pixel noise")):
-        lv = [t for t in table if t["factor"] == factor and t["jobs"] > t["failed"]]
-        if not lv:
+        if not any(t["factor"] == factor for t in table):
             continue
+        lv = [t for t in _with_baseline(table, factor) if t["jobs"] > t["failed"]]
         fig, axes = plt.subplots(1, 3, figsize=(11, 3.3))
         labels = [_level(t, factor) for t in lv]
         for key, ax, lab in zip(("symbol_accuracy", "angle_error_deg", "percent_correct"), axes,
@@ -227,13 +230,29 @@ def _figures(rep: Report, result, table) -> None:
         rep.figure(fig, f"factor_{factor}", f"Effect of {title} (other settings at the baseline).")
 
 
+def _with_baseline(table, factor) -> list[dict]:
+    """The levels of one factor, the baseline's own level included, in a natural order."""
+    lv = [t for t in table if t["factor"] in (factor, "baseline")]
+    if factor == "frame_rate":
+        return sorted(lv, key=lambda t: (-_rate_of(t), t["condition"]))
+    if factor == "image_size":
+        return sorted(lv, key=lambda t: int(_level(t, factor).split("x")[0]))
+    if factor == "view":
+        order = ("front", "45", "side")
+        return sorted(lv, key=lambda t: order.index(_level(t, factor)) if _level(t, factor) in order else 9)
+    if factor == "noise":
+        return sorted(lv, key=lambda t: float(_level(t, factor).split("=")[1]))
+    return lv
+
+
 def _rate_of(t) -> float:
     return float(t["condition"].split(" Hz")[0])
 
 
 def _level(t, factor) -> str:
     parts = t["condition"].split(", ")
-    return {"image_size": parts[1], "view": parts[2], "compression": parts[3], "noise": parts[4]}.get(factor, t["condition"])
+    levels = {"frame_rate": parts[0], "image_size": parts[1], "view": parts[2], "compression": parts[3], "noise": parts[4]}
+    return levels.get(factor, t["condition"])
 
 
 def write_report(result, outdir, capture_note: str = "") -> str:

@@ -87,10 +87,36 @@ def render_pose(
     score_json: str = "null",
     effort_json: str = "null",
     progress: bool = False,
+    camera: Camera | None = None,
 ) -> Path:
-    """Render `pose` into `outdir` (video and ``truth.npz``); return the video path."""
+    """Render `pose` into `outdir`: the frames and their ``truth.npz``.
+
+    Parameters
+    ----------
+    pose : Pose
+    outdir : str or Path
+        Created if needed.
+    size : (int, int)
+        Image (width, height), pixels (ignored when `camera` is given).
+    view : {"front", "45", "side"}
+        Preset camera (:meth:`Camera.for_view`); recorded in the truth.
+    style : {"mannequin", "stick", "markers"}
+    video_name : str
+        ``*.mp4`` for a video, a name without suffix for a PNG folder.
+    score_json, effort_json : str
+        JSON text stored in the truth sidecar.
+    progress : bool
+        Show a progress bar over frames.
+    camera : Camera, optional
+        Use this camera instead of the `view` preset.
+
+    Returns
+    -------
+    Path
+        The video file (or frame folder).
+    """
     outdir = Path(outdir)
-    camera = Camera.for_view(view, size, pose.body.height)
+    camera = camera if camera is not None else Camera.for_view(view, size, pose.body.height)
     renderer = make_renderer(pose, camera, style)
     fields = truth_fields(pose, camera, score_json=score_json, effort_json=effort_json, view=view, style=style)
     video = outdir / video_name
@@ -121,10 +147,12 @@ def render_score(
     emotion: str | None = None,
     progress: bool = True,
     body: Body | None = None,
+    video_name: str = "video.mp4",
 ) -> Path:
     """Perform a score with the virtual dancer and render it.
 
-    Writes ``OUTDIR/video.mp4``, ``OUTDIR/truth.npz`` and ``OUTDIR/score.lab``.
+    Writes ``OUTDIR/video.mp4`` (or `video_name`), ``OUTDIR/truth.npz`` and
+    ``OUTDIR/score.lab``.
 
     Parameters
     ----------
@@ -142,6 +170,8 @@ def render_score(
         Show a progress bar over frames.
     body : Body, optional
         Default ``Body()``.
+    video_name : str
+        ``*.mp4`` for a video, a name without suffix for a folder of PNG frames.
 
     Returns
     -------
@@ -169,6 +199,7 @@ def render_score(
         score_json=dumps(score, "json"),
         effort_json=json.dumps(asdict(score.resolved_effort())),
         progress=progress,
+        video_name=video_name,
     )
     write(score, outdir / "score.lab")
     return outdir

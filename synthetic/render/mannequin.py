@@ -69,6 +69,10 @@ _TROUSER_RINGS = (
     ("pelvis", 0.470, 0.098, 0.062),
 )
 _RING_POINTS = 10
+# Head ellipses: (scale, shift towards the light in semi-axes).
+_HEAD_LAYERS = ((1.0, 0.0), (0.86, 0.10), (0.45, 0.35))
+_FACE_POINTS = ("left_eye", "right_eye", "nose", "mouth_left", "mouth_right", "left_ear", "right_ear",
+                "left_eye_inner", "right_eye_inner", "left_eye_outer", "right_eye_outer")
 
 
 def fixed(p: np.ndarray) -> np.ndarray:
@@ -188,7 +192,12 @@ class Mannequin:
         self._hull_depth = np.stack([camera.depth(pose.joints[:, chest]), camera.depth(pose.joints[:, pelvis])], 1)
         self._hull_colour = [[_gain(PALETTE[c], g) for _, _, g in _HULL_LAYERS] for c in ("shirt", "trousers")]
         self._head = self._head_geometry()
-        self._nose_colours = (_gain(PALETTE["skin"], 0.72), _gain(PALETTE["skin"], 0.98))
+        skin, hair = PALETTE["skin"], PALETTE["hair"]
+        self._head_colours = {
+            "skin": skin, "skin_rim": _gain(skin, 0.62), "skin_light": _gain(skin, 1.08),
+            "hair": hair, "hair_rim": _gain(hair, 0.62), "ear": _gain(skin, 0.8),
+            "nose_rim": _gain(skin, 0.72), "nose": _gain(skin, 0.98),
+        }
         self._shadow = self._shadow_polygons()
 
     # ---------------------------------------------------------------- geometry
@@ -208,8 +217,9 @@ class Mannequin:
         return uv, np.nanmean(uv, axis=1)
 
     def _head_geometry(self) -> dict:
+        """Everything the head needs, per frame, as OpenCV fixed-point Python ints."""
         pose, cam = self.pose, self.camera
-        H = pose.body.height
+        H, f = pose.body.height, cam.K[1, 1]
         axes = pose.head_axes()  # (T,3,3) rows right, forward, up
         radii = np.array(HEAD_RADII) * H
         centre = pose.points["head_centre"]
@@ -219,28 +229,61 @@ class Mannequin:
         out = {}
         for key, c, r in (("skin", centre, radii), ("hair", hair_centre, radii * (1.06, 1.0, 0.97))):
             uv, z = cam.project(c, True)
-            J = cam.K[1, 1] / z[:, None, None] * cam.R[None, :2]  # (T,2,3)
-            A = np.swapaxes(axes, 1, 2) * r  # columns: scaled axes
-            M = J @ A
-            out[key] = (uv, z) + _ellipse_params(M @ np.swapaxes(M, 1, 2))
+            # Silhouette of the ellipsoid: its covariance through the local
+            # (affine) projection at its centre.
+            J = f / z[:, None, None] * cam.R[None, :2]  # (T,2,3)
+            M = J @ (np.swapaxes(axes, 1, 2) * r)
+            half, angle = _ellipse_params(M @ np.swapaxes(M, 1, 2))
+            out[key + "_depth"] = z
+            for scale, shift in _HEAD_LAYERS:
+                out[(key, scale)] = (
+                    fixed(uv + shift * half[:, :1] * LIGHT).tolist(),
+                    fixed(np.maximum(half * scale, 0.5)).tolist(),
+                    angle.tolist(),
+                )
         to_cam = cam.position - centre
         to_cam /= np.linalg.norm(to_cam, axis=1, keepdims=True)
-        out["facing"] = np.sum(axes[:, 1] * to_cam, axis=1)
-        out["side"] = np.sum(axes[:, 0] * to_cam, axis=1)  # > 0: the right ear is seen
         out["depth"] = cam.depth(centre) - radii[1]
-        out["scale"] = cam.K[1, 1] / cam.depth(centre) * H  # pixels per body height
-        names = ("left_eye", "right_eye", "nose", "mouth_left", "mouth_right", "left_ear", "right_ear",
-                 "left_eye_inner", "right_eye_inner", "left_eye_outer", "right_eye_outer")
-        out["pts"] = {n: cam.project(pose.points[n]) for n in names}
-        # The nose: a small tapered capsule from its root to its tip, so that it
-        # stands out of the head's outline in profile.
-        (r_uv, r_z), (t_uv, t_z) = cam.project(pose.points["nose_root"], True), cam.project(pose.points["nose"], True)
-        f = cam.K[1, 1]
-        out["nose"] = [fixed(capsule_outlines(r_uv, t_uv, sc * 0.008 * H * f / r_z, sc * 0.011 * H * f / t_z))
-                       for sc in (1.0, 0.6)]
+        s = f / cam.depth(centre) * H  # pixels per body height
+        out["thin"] = np.maximum(1, np.round(0.007 * s)).astype(int).tolist()
+        pts = {n: cam.project(pose.points[n]) for n in _FACE_POINTS}
         # Outward normals of the features decide which ones face the camera.
-        out["cos"] = {n: np.sum((pose.points[n] - centre) * to_cam, 1) / np.linalg.norm(pose.points[n] - centre, axis=1)
-                      for n in names}
+        cos = {n: np.sum((pose.points[n] - centre) * to_cam, 1) / np.linalg.norm(pose.points[n] - centre, axis=1)
+               for n in _FACE_POINTS}
+        side = np.sum(axes[:, 0] * to_cam, axis=1)  # > 0: the right ear is seen
+        facing = np.sum(axes[:, 1] * to_cam, axis=1) > -0.3
+        r = np.maximum(1.0, 0.016 * s)
+        ear_axes = fixed(np.stack([0.6 * r, r], 1)).tolist()
+        out["ears"] = [
+            ((side > -0.35) & (cos["right_ear"] > -0.35)).tolist(), fixed(pts["right_ear"]).tolist(), ear_axes,
+            ((side < 0.35) & (cos["left_ear"] > -0.35)).tolist(), fixed(pts["left_ear"]).tolist(), ear_axes,
+        ]
+        up = pts["left_eye"] + pts["right_eye"] - pts["mouth_left"] - pts["mouth_right"]
+        up /= np.maximum(np.linalg.norm(up, axis=1, keepdims=True), 1e-9)
+        out["eyes"] = []
+        for side_name in ("left", "right"):
+            inner, outer = pts[f"{side_name}_eye_inner"], pts[f"{side_name}_eye_outer"]
+            half = np.maximum(1.0, 0.5 * np.linalg.norm(outer - inner, axis=1))
+            d = outer - inner
+            brow = up * 1.1 * half[:, None]
+            out["eyes"].append((
+                (facing & (cos[f"{side_name}_eye"] > 0.1)).tolist(),
+                fixed(pts[f"{side_name}_eye"]).tolist(),
+                fixed(np.stack([half, 0.55 * half], 1)).tolist(),
+                np.degrees(np.arctan2(d[:, 1], d[:, 0])).tolist(),
+                np.round(np.maximum(0.8, 0.45 * half) * _ONE).astype(int).tolist(),
+                fixed(inner + brow).tolist(),
+                fixed(outer + 0.8 * brow).tolist(),
+            ))
+        # The nose: a small tapered capsule from its root to its tip, which
+        # rounds the profile (a nose standing further out of the head measured
+        # slightly worse with BlazePose at the body joints).
+        (r_uv, r_z), (t_uv, t_z) = cam.project(pose.points["nose_root"], True), cam.project(pose.points["nose"], True)
+        out["nose"] = (facing & (cos["nose"] > -0.25)).tolist()
+        out["nose_polys"] = [fixed(capsule_outlines(r_uv, t_uv, sc * 0.008 * H * f / r_z, sc * 0.011 * H * f / t_z))
+                             for sc in (1.0, 0.6)]
+        out["mouth"] = (facing & (np.maximum(cos["mouth_left"], cos["mouth_right"]) > 0.0)).tolist()
+        out["mouth_pts"] = (fixed(pts["mouth_left"]).tolist(), fixed(pts["mouth_right"]).tolist())
         return out
 
     def _shadow_polygons(self) -> np.ndarray:
@@ -281,54 +324,34 @@ class Mannequin:
         size = np.sqrt(cv2.contourArea(hull) + 1.0)
         for (sc, sh, _), colour in zip(_HULL_LAYERS, self._hull_colour[which]):
             poly = c + (hull - c) * sc + sh * 0.5 * size * LIGHT
-            cv2.fillConvexPoly(img, fixed(poly), colour, cv2.LINE_AA, SHIFT)
+            cv2.fillConvexPoly(img, np.rint(poly * _ONE).astype(np.int32), colour, cv2.LINE_AA, SHIFT)
 
-    def _ellipse(self, img, key: str, i: int, colour, scale=1.0, shift=0.0) -> None:
-        uv, _, axes, angle = self._head[key]
-        if not np.isfinite(uv[i]).all():
-            return
-        c = uv[i] + shift * axes[i, 0] * LIGHT
-        ax = np.maximum(axes[i] * scale, 0.5)
-        cv2.ellipse(img, tuple(fixed(c)), tuple(fixed(ax)), float(angle[i]), 0, 360, colour, -1, cv2.LINE_AA, SHIFT)
+    def _ellipse(self, img, key: str, scale: float, i: int, colour) -> None:
+        centre, half, angle = self._head[(key, scale)][0][i], self._head[(key, scale)][1][i], self._head[(key, scale)][2][i]
+        cv2.ellipse(img, centre, half, angle, 0, 360, colour, -1, cv2.LINE_AA, SHIFT)
 
     def _draw_head(self, img, i: int) -> None:
-        hd = self._head
-        skin_first = hd["skin"][1][i] >= hd["hair"][1][i]
-        layers = [("skin", PALETTE["skin"]), ("hair", PALETTE["hair"])]
-        if not skin_first:
-            layers.reverse()
-        for key, colour in layers:
-            self._ellipse(img, key, i, _gain(colour, 0.62))
-            self._ellipse(img, key, i, colour, 0.86, 0.10)
+        hd, col = self._head, self._head_colours
+        skin_first = hd["skin_depth"][i] >= hd["hair_depth"][i]
+        order = ("skin", "hair") if skin_first else ("hair", "skin")
+        for key in order:
+            self._ellipse(img, key, 1.0, i, col[key + "_rim"])
+            self._ellipse(img, key, 0.86, i, col[key])
         if not skin_first:
             # Hair behind: the face shows; its highlight sits on the forehead side.
-            self._ellipse(img, "skin", i, _gain(PALETTE["skin"], 1.08), 0.45, 0.35)
-        s = hd["scale"][i]
-        pts = hd["pts"]
-        for ear, cond in (("right_ear", hd["side"][i] > -0.35), ("left_ear", hd["side"][i] < 0.35)):
-            if cond and hd["cos"][ear][i] > -0.35:
-                r = max(1.0, 0.016 * s)
-                cv2.ellipse(img, tuple(fixed(pts[ear][i])), tuple(fixed(np.array([0.6 * r, r]))), 0, 0, 360,
-                            _gain(PALETTE["skin"], 0.8), -1, cv2.LINE_AA, SHIFT)
-        if hd["facing"][i] <= -0.3:
-            return
-        for side in ("left", "right"):
-            eye = f"{side}_eye"
-            if hd["cos"][eye][i] <= 0.1:
-                continue
-            inner, outer = pts[f"{side}_eye_inner"][i], pts[f"{side}_eye_outer"][i]
-            half = max(1.0, 0.5 * np.linalg.norm(outer - inner))
-            ang = np.degrees(np.arctan2(*(outer - inner)[::-1]))
-            cv2.ellipse(img, tuple(fixed(pts[eye][i])), tuple(fixed(np.array([half, 0.55 * half]))), float(ang), 0, 360,
-                        PALETTE["eye_white"], -1, cv2.LINE_AA, SHIFT)
-            cv2.circle(img, tuple(fixed(pts[eye][i])), int(max(0.8, 0.45 * half) * _ONE), PALETTE["iris"], -1, cv2.LINE_AA, SHIFT)
-            up = _unit(0.5 * (pts["left_eye"][i] + pts["right_eye"][i]) - 0.5 * (pts["mouth_left"][i] + pts["mouth_right"][i]))
-            up = up * 1.1 * half
-            cv2.line(img, tuple(fixed(inner + up)), tuple(fixed(outer + up * 0.8)), PALETTE["brow"],
-                     max(1, round(0.007 * s)), cv2.LINE_AA, SHIFT)
-        if hd["cos"]["nose"][i] > -0.25:  # in profile too
-            for poly, colour in zip(hd["nose"], self._nose_colours):
+            self._ellipse(img, "skin", 0.45, i, col["skin_light"])
+        show_r, c_r, a_r, show_l, c_l, a_l = hd["ears"]
+        for show, c, a in ((show_r, c_r, a_r), (show_l, c_l, a_l)):
+            if show[i]:
+                cv2.ellipse(img, c[i], a[i], 0, 0, 360, col["ear"], -1, cv2.LINE_AA, SHIFT)
+        thin = hd["thin"][i]
+        for show, c, half, ang, iris, b0, b1 in hd["eyes"]:
+            if show[i]:
+                cv2.ellipse(img, c[i], half[i], ang[i], 0, 360, PALETTE["eye_white"], -1, cv2.LINE_AA, SHIFT)
+                cv2.circle(img, c[i], iris[i], PALETTE["iris"], -1, cv2.LINE_AA, SHIFT)
+                cv2.line(img, b0[i], b1[i], PALETTE["brow"], thin, cv2.LINE_AA, SHIFT)
+        if hd["nose"][i]:
+            for poly, colour in zip(hd["nose_polys"], (col["nose_rim"], col["nose"])):
                 cv2.fillConvexPoly(img, poly[i], colour, cv2.LINE_AA, SHIFT)
-        ml, mr = pts["mouth_left"][i], pts["mouth_right"][i]
-        if max(hd["cos"]["mouth_left"][i], hd["cos"]["mouth_right"][i]) > 0.0:
-            cv2.line(img, tuple(fixed(ml)), tuple(fixed(mr)), PALETTE["mouth"], max(1, round(0.007 * s)), cv2.LINE_AA, SHIFT)
+        if hd["mouth"][i]:
+            cv2.line(img, hd["mouth_pts"][0][i], hd["mouth_pts"][1][i], PALETTE["mouth"], thin, cv2.LINE_AA, SHIFT)

@@ -304,8 +304,8 @@ def floor_background(
     w, h = camera.size
     img = np.empty((h, w, 3), np.uint8)
     img[:] = wall
-    # The floor polygon is the image region whose viewing rays hit z = 0 in
-    # front of the camera: rasterise it per row from the horizon line.
+    # The floor: a very large square on z = 0, clipped at the near plane, so
+    # that its far edge lies on (practically) the horizon.
     big = extent * 50
     corners = np.array([[-big, -big, 0], [big, -big, 0], [big, big, 0], [-big, big, 0]], float)
     _fill_world_polygon(img, camera, corners, floor)

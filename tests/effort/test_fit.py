@@ -44,7 +44,7 @@ def test_space_from_the_inward_modulation(space):
 
 def test_space_far_outside_the_prior_stays_finite():
     est = fit_space(TAU, -0.5 * np.sin(np.pi * TAU))  # five times the deepest inward pull
-    assert est.median == pytest.approx(0.0, abs=1e-6)
+    assert est.median == pytest.approx(0.0, abs=1e-3)
     assert np.all(np.isfinite(est.ci90))
 
 

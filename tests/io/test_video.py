@@ -99,11 +99,9 @@ def test_unreadable_inputs_raise(tmp_path):
 
 def test_writer_is_atomic_and_checks_sizes(tmp_path):
     out = tmp_path / "o.avi"
-    with pytest.raises(VideoError, match="frame 1 has size 32x48"):
-        with VideoWriter(out, 10, (64, 48)) as w:
-            w.write(_frame(0))
-            w.write(_frame(1, 32, 48))
+    with pytest.raises(VideoError, match="frame 1 has size 32x48"), VideoWriter(out, 10, (64, 48)) as w:
+        w.write(_frame(0))
+        w.write(_frame(1, 32, 48))
     assert list(tmp_path.iterdir()) == []  # nothing half-written left behind
-    with pytest.raises(VideoError, match="extension"):
-        with VideoWriter(tmp_path / "o.gif", 10, (64, 48)):
-            pass
+    with pytest.raises(VideoError, match="extension"), VideoWriter(tmp_path / "o.gif", 10, (64, 48)):
+        pass

@@ -40,6 +40,9 @@ def test_pose_squats_error_distribution(fixture_path, blazepose):
     q = np.percentile(err, [50, 90, 95, 99])
     assert within >= 0.95, f"only {within:.1%} within 31 px; percentiles 50/90/95/99 = {q}"
     assert q[0] <= 8.0, f"median {q[0]:.2f} px"
+    # Relative depth z uses MediaPipe's scale (z * image width): same slope.
+    slope = np.polyfit(expected[:, :, 2].ravel(), track.xy[:, :, 2].ravel(), 1)[0]
+    assert 0.85 <= slope <= 1.15, f"z slope {slope:.3f} against MediaPipe's"  # measured 0.96
     # Hip-centred world landmarks agree too (no MediaPipe tolerance; ours: 0.2 m at p95).
     world = np.array(json.loads(fixture_path("mediapipe/pose_squats_3d.full.json").read_text()))
     assert np.percentile(np.abs(track.world - world), 95) <= 0.2

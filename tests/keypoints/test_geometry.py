@@ -73,3 +73,11 @@ def test_world_landmarks_rotate_with_the_crop():
     est = decode_outputs(outputs, np.array([0, 0, 100, 100, np.pi / 2]), refine=False)
     # Crop turned 90 degrees clockwise: crop-up is image +x.
     np.testing.assert_allclose(est.world[0], [0.5, 0.0, 0.1], atol=1e-12)
+
+
+def test_degenerate_aux_points_give_an_unusable_crop():
+    from capture2notation.keypoints.blazepose import _usable
+
+    assert not _usable(crop_from_aux(np.array([[10.0, 10.0], [10.0, 10.0]])))
+    assert not _usable(crop_from_aux(np.array([[np.nan, 10.0], [10.0, 10.0]])))
+    assert _usable(crop_from_aux(np.array([[10.0, 100.0], [10.0, 60.0]])))

@@ -20,7 +20,7 @@ RED = MarkerSpec.from_colour("nose", (0, 0, 220))
 def _disc(img, xy, colour, r=6.0):
     """Anti-aliased disc at a sub-pixel centre (pixel centres at integers)."""
     shift = 4
-    c = tuple(int(round(v * (1 << shift))) for v in xy)
+    c = tuple(round(v * (1 << shift)) for v in xy)
     cv2.circle(img, c, int(r * (1 << shift)), colour, -1, cv2.LINE_AA, shift)
 
 
@@ -117,3 +117,13 @@ def test_renderer_markers_median_error(demo_pose, view):
     assert np.percentile(err, 95) <= 2.0  # measured ~0.3 px
     # Markers that are not drawn (self-occluded) must not be reported.
     assert np.isnan(track.xy[:, idx, 0][~truth["drawn"][:, idx]]).all()
+
+
+def test_extract_frames_rejects_bad_input():
+    with pytest.raises(KeypointError, match="openpose"):
+        extract_frames([np.zeros((8, 8, 3), np.uint8)], 10, backend="openpose")
+    with pytest.raises(KeypointError, match="no frames"):
+        extract_frames([], 10, backend="markers", markers=[GREEN])
+    frames = [np.zeros((8, 8, 3), np.uint8), np.zeros((9, 8, 3), np.uint8)]
+    with pytest.raises(KeypointError, match=r"frame 1 is 8x9, expected 8x8"):
+        extract_frames(frames, 10, backend="markers", markers=[GREEN])

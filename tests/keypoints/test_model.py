@@ -9,13 +9,12 @@ import zipfile
 
 import numpy as np
 import pytest
+import tflite2onnx
+from tflite2onnx.layout import Layout
+from tflite2onnx.op.padding import Padding
 
 from capture2notation.errors import ModelError
 from capture2notation.keypoints import model as pm
-
-tflite2onnx = pytest.importorskip("tflite2onnx")
-from tflite2onnx.layout import Layout  # noqa: E402
-from tflite2onnx.op.padding import Padding  # noqa: E402
 
 
 def _pad_op(pads_tensor, layout):
@@ -150,6 +149,9 @@ def test_conversion_needs_the_fix_and_reproduces_the_cache(pose_model_path, tmp_
         tflite2onnx.convert(str(tflite), str(tmp_path / "raw.onnx"))
     out = pm.convert_tflite(tflite, tmp_path / "fixed.onnx")
     pm.verify_onnx(out)
+    # Conversions are byte-for-byte reproducible (concurrent fetches agree).
+    again = pm.convert_tflite(tflite, tmp_path / "again.onnx")
+    assert pm.sha256_file(again) == pm.sha256_file(out)
     import onnxruntime as ort
 
     x = np.random.default_rng(0).random(pm.INPUT_SHAPE, dtype=np.float32)
@@ -157,3 +159,47 @@ def test_conversion_needs_the_fix_and_reproduces_the_cache(pose_model_path, tmp_
     new = ort.InferenceSession(str(out), providers=["CPUExecutionProvider"]).run(None, {"input_1": x})
     for r, n in zip(ref, new):
         np.testing.assert_allclose(n, r, rtol=0, atol=1e-5)
+
+
+def test_session_rejects_a_model_that_is_not_blazepose(tmp_path):
+    import onnx
+    from onnx import TensorProto, helper
+
+    from capture2notation.keypoints.blazepose import make_session
+
+    graph = helper.make_graph(
+        [helper.make_node("Identity", ["x"], ["y"])], "g",
+        [helper.make_tensor_value_info("x", TensorProto.FLOAT, [1, 3, 256, 256])],
+        [helper.make_tensor_value_info("y", TensorProto.FLOAT, [1, 3, 256, 256])],
+    )  # fmt: skip
+    path = tmp_path / "other.onnx"
+    onnx.save(helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)], ir_version=8), path)
+    with pytest.raises(ModelError, match=r"other\.onnx: not the BlazePose"):
+        make_session(path)
+    (tmp_path / "junk.onnx").write_bytes(b"junk")
+    with pytest.raises(ModelError, match="junk.onnx"):
+        make_session(tmp_path / "junk.onnx")
+
+
+def test_first_use_fetches_automatically_and_caches(tmp_path, monkeypatch, caplog):
+    """An empty cache triggers one fetch (with a message); a valid cache is reused."""
+    monkeypatch.delenv(pm.ENV_MODEL, raising=False)
+    monkeypatch.setenv(pm.ENV_CACHE, str(tmp_path))
+    calls = []
+
+    def fake_fetch(cache=None, **kw):
+        calls.append(cache)
+        model = pm.cached_model_path(cache)
+        model.write_bytes(b"model bytes")
+        manifest = {"onnx_sha256": pm.sha256_file(model)}
+        (cache / pm.MANIFEST_NAME).write_text(json.dumps(manifest))
+        return model
+
+    monkeypatch.setattr(pm, "fetch_model", fake_fetch)
+    with caplog.at_level("WARNING", logger=pm.__name__):
+        first = pm.resolve_model()
+    assert calls == [tmp_path] and "fetching mediapipe==0.10.14" in caplog.text
+    assert pm.resolve_model() == first and len(calls) == 1  # cached now
+    first.write_bytes(b"tampered")  # hash no longer matches the manifest
+    pm.resolve_model()
+    assert len(calls) == 2

@@ -58,6 +58,10 @@ def test_defaults_emotion_comments_and_crlf():
     assert s.symbols == (Symbol(0, 1, "head", "forward", "high"),)
 
 
+def test_byte_order_mark_is_ignored():
+    assert lab.loads("\ufefftitle: x\n0 1 head forward high\n").title == "x"
+
+
 def test_title_keeps_hash_and_quoted_whitespace():
     assert lab.loads("title: No. #7 # not a comment\n").title == "No. #7 # not a comment"
     assert lab.loads('title: "  padded\\t "\n').title == "  padded\t "

@@ -73,6 +73,17 @@ def test_render_with_an_emotion_takes_its_tempo_and_effort(tmp_path, score_file)
     assert read(out / "score.lab").emotion == "sad"
 
 
+def test_render_png_frames_match_the_truth(tmp_path, score_file):
+    out = tmp_path / "png"
+    res = CliRunner().invoke(main, ["render", str(score_file), "-o", str(out), "--fps", "4", "--size", "64x48",
+                                    "--png"])
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in out.iterdir()) == ["frames", "score.lab", "truth.npz"]
+    frames = sorted((out / "frames").iterdir())
+    assert len(frames) == read_truth(out / "truth.npz").n_frames == 3
+    assert cv2.imread(str(frames[0])).shape == (48, 64, 3)
+
+
 @pytest.mark.parametrize(
     "args, words",
     [

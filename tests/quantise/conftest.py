@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import pytest
 
-from quantise_motions import arm_angles, build_motion
+# The helpers module sits beside this file (tests are not a package).
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from quantise_motions import arm_angles, build_motion  # noqa: E402
 
 
 @pytest.fixture

@@ -2,17 +2,16 @@
 
 These do not depend on the virtual dancer: a movement eases one joint's
 Euler angles from their current values to a target with the Effort logistic,
-exactly as a notation symbol would (start at its start beat, arrive at its end).
+exactly as a notation symbol would (start at its start beat, arrive at its
+end, each beat at its nearest frame as the renderer times them).
 """
 
 from __future__ import annotations
 
-from fractions import Fraction
-
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
+from capture2notation.body import JOINTS, forward_kinematics, joint_index
 from capture2notation.effort.model import progress
 from capture2notation.notation.directions import canonical_vector
 
@@ -57,7 +56,8 @@ def build_motion(moves, tempo, fps=25.0, beats=None, b=-3.0, x0=0.45):
     for s, d, joint, target in sorted(moves, key=lambda m: m[0]):
         j = joint_index(joint)
         cur = current.get(j, np.zeros(3))
-        t0, t1 = float(s) * spb, float(s + d) * spb
+        # Like the virtual dancer, a beat happens at its nearest frame.
+        t0, t1 = (np.floor(float(x) * spb * fps + 0.5) / fps for x in (s, s + d))
         p = progress((t - t0) / (t1 - t0), b, x0)
         m = t >= t0
         angles[m, j] = cur + (np.asarray(target, float) - cur) * p[m, None]

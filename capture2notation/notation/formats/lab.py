@@ -193,6 +193,7 @@ def loads(text: str, path: str | None = None) -> Score:
     """
     header: dict[str, tuple[object, int]] = {}
     rows: list[tuple[Symbol, int]] = []
+    text = text.removeprefix("\ufeff")  # byte-order mark left by some editors
     for lineno, raw in enumerate(text.split("\n"), 1):
         line = raw[:-1] if raw.endswith("\r") else raw
         stripped = line.strip()

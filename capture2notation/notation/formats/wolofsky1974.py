@@ -116,6 +116,7 @@ def loads(text: str, path: str | None = None) -> Score:
     """
     rows: list[tuple[Symbol, int]] = []
     seen_data = False
+    text = text.removeprefix("\ufeff")  # byte-order mark left by some editors
     for lineno, raw in enumerate(text.split("\n"), 1):
         line = raw.split("#", 1)[0].strip()
         if not line:

@@ -1,4 +1,4 @@
-"""Synthetic observations of known poses for the fitting tests."""
+"""Synthetic observations of known poses for the fitting tests (as the `synth` fixture)."""
 
 from __future__ import annotations
 
@@ -64,3 +64,16 @@ def limb_direction_errors(joints, truth) -> np.ndarray:
             cos = np.sum(u * v, -1) / np.linalg.norm(u, axis=-1) / np.linalg.norm(v, axis=-1)
             out.append(np.degrees(np.arccos(np.clip(cos, -1, 1))))
     return np.concatenate(out)
+
+
+# The test modules are imported with --import-mode=importlib, so helpers reach
+# them as fixtures rather than imports.
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def synth():
+    """The helpers above: ``synth.make_motion``, ``synth.observe``, ``synth.limb_direction_errors``."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(make_motion=make_motion, observe=observe, limb_direction_errors=limb_direction_errors)

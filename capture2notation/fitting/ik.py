@@ -1,0 +1,164 @@
+"""Closed-form inverse kinematics from 3D segment directions: the solver's starting pose.
+
+Gauss–Newton on Euler angles only finds the nearest minimum; a raised arm
+started from the rest pose can settle in a mirror pose that projects the same.
+So every frame starts from the pose computed directly from measured 3D
+directions (world landmarks of the keypoint model, or mocap joints):
+
+* pelvis: x along right hip − left hip, z as close to world up as possible;
+* waist and chest: share equally the bend that takes the pelvis's up to the
+  pelvis → neck direction; the chest takes the twist of the shoulder line;
+* shoulder / hip: the frame whose −z is the upper arm / thigh and whose
+  forward (+y) lies in the plane of the bend, towards the forearm (elbow
+  flexion swings forward) or away from the shin (knee flexion swings back);
+  with a straight limb, the forward axis follows the shortest swing from rest;
+* elbow / knee: the angle between the two segments.
+
+Wrists, ankles, neck and head start at rest.  Each Euler triple is the one of
+the two equivalent triples nearer to the joint's limits, then clipped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..body import JOINTS, euler_to_matrix, joint_index, matrix_to_euler
+from .model import PoseModel
+
+__all__ = ["initial_angles"]
+
+_J = len(JOINTS)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return v / n
+
+
+def _swing(u: np.ndarray) -> np.ndarray:
+    """Shortest rotation taking −z onto unit vectors `u` (..., 3) -> (..., 3, 3)."""
+    a = np.array([0.0, 0.0, -1.0])
+    axis = np.cross(a, u)
+    s = np.linalg.norm(axis, axis=-1)
+    c = np.clip(np.sum(a * u, axis=-1), -1.0, 1.0)
+    # Antiparallel (straight up): turn through the front, about x.
+    axis = np.where((s < 1e-9)[..., None], np.array([1.0, 0.0, 0.0]), axis / np.maximum(s, 1e-12)[..., None])
+    ang = np.arctan2(s, c)
+    return _rodrigues(axis, ang)
+
+
+def _rodrigues(axis: np.ndarray, ang: np.ndarray) -> np.ndarray:
+    x, y, z = axis[..., 0], axis[..., 1], axis[..., 2]
+    c, s = np.cos(ang), np.sin(ang)
+    C = 1 - c
+    return np.stack([
+        np.stack([c + x * x * C, x * y * C - z * s, x * z * C + y * s], -1),
+        np.stack([y * x * C + z * s, c + y * y * C, y * z * C - x * s], -1),
+        np.stack([z * x * C - y * s, z * y * C + x * s, c + z * z * C], -1),
+    ], -2)
+
+
+def _euler_in_limits(R: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """Euler angles of `R` (..., 3, 3): the equivalent triple nearer the limits (3, 2), clipped."""
+    e1 = matrix_to_euler(R)
+    e2 = np.stack([e1[..., 0] + np.pi, np.pi - e1[..., 1], e1[..., 2] + np.pi], -1)
+    e2 = np.angle(np.exp(1j * e2))  # wrap to (-pi, pi]
+    cands = []
+    for e in (e1, e2):
+        # Also try each angle shifted by a full turn (limits may exceed +-180 deg).
+        alt = np.where(e < lim[:, 0], e + 2 * np.pi, np.where(e > lim[:, 1], e - 2 * np.pi, e))
+        cands.append(alt)
+    viol = [np.sum(np.maximum(lim[:, 0] - c, 0) + np.maximum(c - lim[:, 1], 0), axis=-1) for c in cands]
+    best = np.where((viol[0] <= viol[1])[..., None], cands[0], cands[1])
+    return np.clip(best, lim[:, 0], lim[:, 1])
+
+
+def initial_angles(points: np.ndarray, model: PoseModel) -> np.ndarray:
+    """Starting angles from 3D joint positions (any origin), world axes.
+
+    Parameters
+    ----------
+    points : (T, J, 3) ndarray
+        Measured positions of our joints, z up; NaN where unknown (those
+        parts start at rest).
+    model : PoseModel
+        Supplies the limits.
+
+    Returns
+    -------
+    (T, J, 3) ndarray
+        Euler angles, radians, within the limits.
+    """
+    P = np.asarray(points, float)
+    T = P.shape[0]
+    lim = model.body.limits
+    ang = np.zeros((T, _J, 3))
+    eye = np.broadcast_to(np.eye(3), (T, 3, 3))
+
+    def seg(a, b):
+        return _unit(P[:, joint_index(b)] - P[:, joint_index(a)])
+
+    # Pelvis.
+    x = seg("left_hip", "right_hip")
+    xs = seg("left_shoulder", "right_shoulder")
+    x = np.where(np.isfinite(x), x, xs)
+    up = np.array([0.0, 0.0, 1.0])
+    y = _unit(np.cross(up, x))
+    z = np.cross(x, y)
+    G = np.stack([x, y, z], axis=-1)
+    ok = np.all(np.isfinite(G), axis=(1, 2))
+    G = np.where(ok[:, None, None], G, eye)
+    ang[:, 0] = np.where(ok[:, None], matrix_to_euler(G), 0.0)
+
+    # Waist and chest: half the bend each; the chest takes the twist.
+    d = seg("pelvis", "neck")
+    d_loc = np.einsum("tji,tj->ti", G, d)
+    ok = np.all(np.isfinite(d_loc), axis=1)
+    d_loc = np.where(ok[:, None], d_loc, up)
+    axis = np.cross(up, d_loc)
+    s = np.linalg.norm(axis, axis=1)
+    axis = np.where((s > 1e-9)[:, None], axis / np.maximum(s, 1e-12)[:, None], np.array([1.0, 0.0, 0.0]))
+    theta = np.arctan2(s, d_loc[:, 2])
+    half = _rodrigues(axis, theta / 2)
+    G_mid = G @ half @ half
+    s_loc = np.einsum("tji,tj->ti", G_mid, xs)
+    phi = np.where(np.all(np.isfinite(s_loc), axis=1), np.arctan2(s_loc[:, 1], s_loc[:, 0]), 0.0)
+    twist = _rodrigues(np.broadcast_to(up, (T, 3)), phi)
+    w, c = joint_index("waist"), joint_index("chest")
+    ang[:, w] = _euler_in_limits(half, lim[w])
+    ang[:, c] = _euler_in_limits(half @ twist, lim[c])
+    G_chest = G @ euler_to_matrix(ang[:, w]) @ euler_to_matrix(ang[:, c])
+    G_pelvis = euler_to_matrix(ang[:, 0])
+
+    for side in ("right", "left"):
+        _limb(ang, P, G_chest, f"{side}_shoulder", f"{side}_elbow", f"{side}_wrist", +1.0, lim)
+        _limb(ang, P, G_pelvis, f"{side}_hip", f"{side}_knee", f"{side}_ankle", -1.0, lim)
+    return ang
+
+
+def _limb(ang, P, G_parent, root, mid, end, sign, lim):
+    """Set the root joint's 3 angles and the middle joint's flexion from two segment directions."""
+    r, m, e = joint_index(root), joint_index(mid), joint_index(end)
+    u = _unit(P[:, m] - P[:, r])
+    f = _unit(P[:, e] - P[:, m])
+    u_l = np.einsum("tji,tj->ti", G_parent, u)
+    f_l = np.einsum("tji,tj->ti", G_parent, f)
+    ok_u = np.all(np.isfinite(u_l), axis=1)
+    if not ok_u.any():
+        return
+    u_l = np.where(ok_u[:, None], u_l, np.array([0.0, 0.0, -1.0]))
+    swing = _swing(u_l)
+    y_rest = swing[..., :, 1]  # forward axis after the shortest swing
+    perp = f_l - np.sum(f_l * u_l, axis=1, keepdims=True) * u_l
+    sin_b = np.linalg.norm(perp, axis=1)
+    bent = np.isfinite(sin_b) & (sin_b > 0.2)
+    y_bend = sign * perp / np.maximum(sin_b, 1e-12)[:, None]
+    y_ax = np.where(bent[:, None], y_bend, y_rest)
+    z_ax = -u_l
+    x_ax = np.cross(y_ax, z_ax)
+    R = np.stack([x_ax, y_ax, z_ax], axis=-1)
+    ang[:, r] = np.where(ok_u[:, None], _euler_in_limits(R, lim[r]), 0.0)
+    beta = np.arccos(np.clip(np.sum(u_l * f_l, axis=1), -1, 1))
+    flex = np.where(np.isfinite(beta) & ok_u, sign * beta, 0.0)
+    ang[:, m, 0] = np.clip(flex, lim[m, 0, 0], lim[m, 0, 1])

@@ -1,0 +1,147 @@
+"""The fidelity study: configuration, grid, one job, determinism, resuming, Dask."""
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from capture2notation.errors import PipelineError
+from pipelines.fidelity.conditions import (
+    Condition,
+    Job,
+    Performance,
+    build_conditions,
+    build_jobs,
+    phrase_complexity,
+    take_variation,
+)
+from pipelines.fidelity.config import StudyConfig, load_config, quick
+from pipelines.fidelity.measure import builtin_scores, kept_frames, perform
+from pipelines.fidelity.runner import run_condition, run_study
+
+synthetic = pytest.importorskip("synthetic.interpret", reason="the virtual dancer is needed to perform phrases")
+
+TINY = dict(
+    phrases=("figure7",), emotions=("happy", "sad"), takes=2, training_takes=2, capture="truth",
+    frame_rates=(25, 5), resampling=("keyframe",), image_sizes=((320, 240),), views=("front",),
+    compression=(0,), noise=(0.0,), bootstrap=3,
+    baseline={"frame_rate": 25, "image_size": (320, 240), "view": "front", "compression": 0, "noise": 0.0},
+)
+
+
+def test_config_from_toml_and_errors(tmp_path):
+    p = tmp_path / "study.toml"
+    p.write_text('seed = 7\nframe_rates = [25, 8.33]\nimage_sizes = [[220, 175]]\n[baseline]\nview = "side"\n')
+    cfg = load_config(p)
+    assert cfg.seed == 7 and cfg.frame_rates == (25, 8.33) and cfg.image_sizes == ((220, 175),)
+    assert cfg.baseline["view"] == "side" and cfg.baseline["image_size"] == (640, 480)
+    p.write_text("sede = 7\n")
+    with pytest.raises(PipelineError, match="unknown setting.*sede"):
+        load_config(p)
+    p.write_text("seed = [\n")
+    with pytest.raises(PipelineError, match="not valid TOML"):
+        load_config(p)
+    with pytest.raises(PipelineError, match="takes"):
+        StudyConfig(takes=1)
+    with pytest.raises(PipelineError, match="view 'top'"):
+        StudyConfig(views=("top",))
+
+
+def test_default_grid_one_factor_at_a_time():
+    conds = build_conditions(StudyConfig())
+    assert conds[0].factor == "baseline"
+    assert len({c.params() for c in conds}) == len(conds)  # no duplicate recordings
+    rates = {(c.frame_rate, c.resampling) for c in conds if c.factor in ("frame_rate", "baseline")}
+    assert rates == {("25", "keyframe"), ("25/2", "keyframe"), ("25/2", "naive"), ("25/3", "keyframe"),
+                     ("25/3", "naive"), ("5", "keyframe"), ("5", "naive")}
+    # 1 baseline + 6 reduced rates + 3 other sizes + 2 other views + 2 compressions + 2 noises
+    assert len(conds) == 16
+    q = build_conditions(quick(StudyConfig(), ("a", "b", "c")))
+    assert len(q) < len(conds)
+
+
+def test_complexity_and_take_variation():
+    scores = builtin_scores()
+    comp = phrase_complexity(scores)
+    assert sorted(comp.values()) == ["easy", "hard", "medium"]
+    p = Performance("figure7", comp["figure7"], "sad", 0, "test")
+    a, b = take_variation(p, 0), take_variation(p, 0)
+    assert a == b
+    other = take_variation(Performance("figure7", comp["figure7"], "sad", 1, "test"), 0)
+    assert other != a
+    assert 30 < float(a["tempo"]) < 45  # sad's 37 bpm, varied by a few percent
+
+
+def perfect_capture(motion, kept, cond, rng):
+    """A capture that sees the kept frames exactly."""
+    j = motion.joints()
+    out = np.full_like(j, np.nan)
+    out[kept] = j[kept]
+    conf = np.zeros(j.shape[:2])
+    conf[kept] = 1.0
+    return out, conf
+
+
+def cond(rate, method):
+    return Condition("frame_rate", rate, method, 320, 240, "front", 0, 0.0)
+
+
+def test_keyframe_resampling_keeps_key_poses_exactly():
+    perf = Performance("port_de_bras", "hard", "happy", 0, "test")
+    full = run_condition(Job(cond("25", "keyframe"), perf), 0, perfect_capture, bootstrap=0)
+    assert full["error"] == ""
+    assert full["symbol_accuracy"] == 1.0 and full["mpjpe_mm"] == pytest.approx(0.0, abs=1e-9)
+    assert full["timing_error_s"] == pytest.approx(0.0, abs=1e-9)
+    kf = run_condition(Job(cond("5", "keyframe"), perf), 0, perfect_capture, bootstrap=0)
+    naive = run_condition(Job(cond("5", "naive"), perf), 0, perfect_capture, bootstrap=0)
+    assert kf["angle_error_deg"] == pytest.approx(0.0, abs=1e-6)  # key frames are never culled
+    assert naive["angle_error_deg"] > 1.0
+    assert kf["kept_frames"] < full["kept_frames"] / 3
+
+
+def test_failed_capture_is_reported_not_invented():
+    def blind(motion, kept, cond_, rng):
+        j = motion.joints()
+        return np.full_like(j, np.nan), np.zeros(j.shape[:2])
+
+    row = run_condition(Job(cond("25", "keyframe"), Performance("figure7", "medium", "sad", 0, "test")), 0, blind)
+    assert "no joint" in row["error"] and "symbol_accuracy" not in row
+
+
+def test_kept_frames_contain_key_frames():
+    score, motion = perform(Performance("figure7", "medium", "angry", 0, "test"), 0, 25.0)
+    kept = kept_frames(cond("25/3", "keyframe"), score, motion.n_frames, motion.fps)
+    ends = {e[2] for e in motion.events}
+    assert ends <= set(kept.tolist()) | {motion.n_frames}
+
+
+def test_same_seed_same_results_and_resume(tmp_path):
+    cfg = StudyConfig(**TINY)
+    a = run_study(cfg, tmp_path / "a", workers=1, progress=False)
+    text = (tmp_path / "a" / "results.csv").read_text()
+    assert a.summary["jobs"] == {"total": 12, "ran": 12, "cached": 0, "failed": 0}
+    assert len(text.strip().splitlines()) == 13
+    again = run_study(cfg, tmp_path / "a", workers=1, progress=False)
+    assert again.summary["jobs"]["ran"] == 0 and again.summary["jobs"]["cached"] == 12
+    assert (tmp_path / "a" / "results.csv").read_text() == text
+    b = run_study(cfg, tmp_path / "b", workers=2, progress=False)
+    assert (tmp_path / "b" / "results.csv").read_text() == text
+    assert b.summary["experiment1"][0]["n"] == 2 * 3 + 1 * 2  # 2 same pairs x3, 1 different pair x2
+    c = run_study(StudyConfig(**{**TINY, "seed": 1}), tmp_path / "c", workers=1, progress=False)
+    assert (tmp_path / "c" / "results.csv").read_text() != text
+
+
+def test_dask_cluster_gives_the_same_results(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    cfg = StudyConfig(**{**TINY, "emotions": ("happy", "angry")})
+    local = run_study(cfg, tmp_path / "local", workers=1, progress=False)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+        dask = run_study(cfg, tmp_path / "dask", scheduler=cl.scheduler_address, progress=False)
+    assert dask.summary["jobs"]["ran"] == 12
+    assert (tmp_path / "dask" / "results.csv").read_text() == (tmp_path / "local" / "results.csv").read_text()
+
+
+def test_unreachable_scheduler_is_a_one_line_error(tmp_path):
+    cfg = StudyConfig(**TINY)
+    with pytest.raises(PipelineError, match="Dask scheduler"):
+        run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False)
