@@ -32,7 +32,11 @@ from fractions import Fraction
 import numpy as np
 
 from capture2notation.effort import estimate_effort
-from capture2notation.effort.emotion import PERFORMER_SD, emotion_probabilities, preset_features
+from capture2notation.effort.emotion import (
+    PERFORMER_SD,
+    emotion_probabilities,
+    preset_features,
+)
 from capture2notation.effort.estimate import _emotion_input
 from capture2notation.effort.presets import PRESETS
 from capture2notation.effort.testing import arc_motion, random_arm_score
@@ -202,7 +206,7 @@ def emotion_figures(test, spread, seed: int, trials_per_pair: int = 200):
             same = max(pa, key=pa.get) == max(pb, key=pb.get)
             ok.append(same == (a == b))
         correct_all += ok
-        print(f"  {a}-{b:<8} {100 * np.mean(ok):5.1f}% correct")
+        print(f"  {a + '-' + b:<14} {100 * np.mean(ok):5.1f}% correct")
     print(f"  overall   {100 * np.mean(correct_all):5.1f}% correct ({len(pairs)} pair types x {trials_per_pair} trials)")
 
 

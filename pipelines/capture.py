@@ -102,7 +102,10 @@ def input_kind(path) -> str:
     if p.is_dir():
         if any(f.suffix.lower() in _IMAGE_SUFFIXES for f in p.iterdir()):
             return "video"
-        raise PipelineError(f"{p}: folder holds no images ({', '.join(_IMAGE_SUFFIXES)}); expected an image sequence")
+        raise PipelineError(
+            f"{p}: folder holds no images ({', '.join(_IMAGE_SUFFIXES)}); expected an image sequence "
+            "(for a render folder give its video.mp4)"
+        )
     if not p.is_file():
         raise PipelineError(f"{p}: no such file or folder")
     ext = p.suffix.lower()

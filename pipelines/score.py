@@ -327,6 +327,7 @@ def _key_pose_figure(res: dict, max_poses: int = 8):
         ax.set_title(f"{m.part} {m.direction} {m.level}\n→ {m.cand_direction or '?'} {m.cand_level} ({m.verdict})",
                      fontsize=8)
     fig.suptitle("Key poses: reference (black, left) and candidate (blue = same symbol, red = different)", fontsize=9)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
     return fig
 
 
@@ -341,12 +342,13 @@ def write_score_report(cand: Side, ref: Side, res: dict, summ: dict, outdir) -> 
 
     rep = Report(f"Score: {Path(cand.label).name} against {Path(ref.label).name}", outdir)
     sa = summ["symbol_agreement"]
+    mean_abs = summ["timing_offset_s"]["mean_abs"]
     rep.paragraph(
         f"Candidate {cand.label} ({cand.kind}, {cand.fps:g} fps) against reference {ref.label} ({ref.kind}, "
         f"{ref.fps:g} fps), aligned by {summ['alignment']['method']}. Symbol agreement "
         f"{'–' if sa is None else f'{sa:.0%}'}, MPJPE {summ['mpjpe_mm']:.0f} mm (pelvis-centred), "
         f"Procrustes-aligned {summ['pa_mpjpe_mm']:.0f} mm, mean |timing offset| "
-        f"{summ['timing_offset_s']['mean_abs'] or float('nan'):.3f} s."
+        f"{float('nan') if mean_abs is None else mean_abs:.3f} s."
     )
     rep.heading("Key poses")
     rep.figure(_key_pose_figure(res), "key_poses", "Stick figures at each key pose of the reference, front view.")

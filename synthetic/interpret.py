@@ -31,7 +31,7 @@ Semantics (``../shared/DESIGN.md``; Wolofsky 1974 ch. IV; Neagle 2005 ch. 5):
   of the weight-bearing feet and as high as their levels allow, so the
   supporting feet stay on the floor; a foot whose support ended is free as
   soon as a gesture of its leg starts.  A gesturing foot never goes below
-  the floor (the knee bends instead).
+  the floor (the knee bends and the foot flexes instead).
 * Unnotated parts hold.  The start pose is standing on both feet, arms and
   legs hanging straight, head and chest upright.
 
@@ -49,12 +49,12 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from capture2notation.body import (
-    JOINTS,
     Body,
     body_frame,
     euler_to_matrix,
     forward_kinematics,
     joint_index,
+    matrix_to_euler,
     segment_vectors,
 )
 from capture2notation.effort.model import progress, space_radius
@@ -204,9 +204,15 @@ def _great_circle_frames(Pa, Pb, s, prefer):
 
 
 def _slerp_dirs(da, db, s):
-    """Unit vectors along the great circle from `da` to `db` at progress `s`."""
-    R = _slerp_frames(np.eye(3), _rot_between(da, db, [1.0, 0.0, 0.0]), s)
-    return R @ da
+    """Unit vectors (n, 3) along the great circle from `da` to `db` at progress `s` (n,).
+
+    Opposite ends go through +x (an arbitrary but fixed choice).
+    """
+    n = np.cross(da, db)
+    if np.linalg.norm(n) < 1e-9:
+        n = np.cross(da, [1.0, 0.0, 0.0]) if abs(da[0]) < 0.9 else np.cross(da, [0.0, 1.0, 0.0])
+    theta = np.arctan2(np.linalg.norm(np.cross(da, db)), da @ db)
+    return _axis_angle(np.broadcast_to(n, np.shape(s) + (3,)), np.asarray(s) * theta) @ da
 
 
 # --- timing --------------------------------------------------------------------
@@ -394,12 +400,13 @@ def _trunk_angles(d, body: Body):
     target = np.arccos(np.clip(uniq[:, 2], -1, 1))
 
     def pose(phi):
-        w = np.clip(euler_near(_axis_angle(axis, phi * 2 / 3), 0.0, lw), lw[:, 0], lw[:, 1])
-        c = np.clip(euler_near(_axis_angle(axis, phi / 3), 0.0, lc), lc[:, 0], lc[:, 1])
+        # The trunk's extremes lie within the principal Euler ranges.
+        w = np.clip(matrix_to_euler(_axis_angle(axis, phi * 2 / 3)), lw[:, 0], lw[:, 1])
+        c = np.clip(matrix_to_euler(_axis_angle(axis, phi / 3)), lc[:, 0], lc[:, 1])
         return w, c
 
     lo, hi = np.zeros(len(uniq)), np.full(len(uniq), np.pi)
-    for _ in range(24):
+    for _ in range(22):
         mid = 0.5 * (lo + hi)
         w, c = pose(mid)
         Rw = euler_to_matrix(w)
@@ -443,14 +450,15 @@ def _planted_after(sup, ges, beat) -> bool:
     return max(effects)[2] if effects else True
 
 
-def _foot_progress(tau, eff: Effort):
-    """Progress of a stepping or landing foot over frames at `tau` (n,).
+def _foot_progress(tau, eff: Effort, arrive: float = FOOT_ARRIVAL):
+    """Progress of a stepping or landing foot (or the weight) over frames at `tau` (n,).
 
-    The foot is on the floor and still by τ = FOOT_ARRIVAL, and at the
-    latest one frame before the symbol's end, so it reads as supporting.
+    Effort logistic, brought to rest (smoothstep) by τ = `arrive` and at the
+    latest one frame before the symbol's end, so the feet read as supporting
+    on its end frame.
     """
     tau = np.asarray(tau, float)
-    arrive = min(FOOT_ARRIVAL, 1.0 - 1.0 / max(len(tau), 1)) if len(tau) > 1 else 1.0
+    arrive = min(arrive, 1.0 - 1.0 / max(len(tau), 1)) if len(tau) > 1 else 1.0
     s = progress(np.minimum(tau / max(arrive, 1e-9), 1.0), eff.time, eff.weight)
     return s * s * (3.0 - 2.0 * s)
 
@@ -555,14 +563,11 @@ class _Support:
             fa = max(f0, last_key)
             m = np.arange(fa + 1, f1 + 1)
             if f1 > fa:
+                # The weight settles a frame before the end (a step: with
+                # the foot, which can only touch down on a straight leg once
+                # the pelvis is over it), so the feet are still on the end frame.
                 tau = (m - fa) / (f1 - fa)
-                if s.direction != "place":
-                    # A step: the pelvis arrives over the new support with the
-                    # foot, which it must do to put the foot down on a straight leg.
-                    sr = _foot_progress(tau, self.eff)
-                else:
-                    sr = progress(tau, self.eff.time, self.eff.weight)
-                    sr = sr * sr * (3.0 - 2.0 * sr)  # the weight arrives settled
+                sr = _foot_progress(tau, self.eff, FOOT_ARRIVAL if s.direction != "place" else 1.0)
                 ra = self.root[fa].copy()
                 self.root[m] = ra + sr[:, None] * (key - ra)
             self.root[f1:] = key
@@ -654,17 +659,24 @@ def _leg_tracks(sup: _Support, symbols, frame, T: int, eff: Effort):
         gest = ~floor
         Q[gest], beta[gest], ankle[gest] = Qg[gest], bg[gest], ankle_g[gest]
         free = gest
-        # The free foot stays above the floor: the ankle no lower than when
-        # standing, and the toe no lower than its rest height either (a
-        # pitched foot can reach lower than its ankle), by bending the knee.
-        floor_z = np.full(T, sup.ankle0)
+        # The free foot stays above the floor (z = 0): the ankle no lower than
+        # the sole's thickness (its standing height less the toe's), and the
+        # toe above the floor too (a pitched foot reaches lower than its
+        # ankle), by bending the knee.
+        floor_z = np.full(T, sup.ankle0 - sup.toe0)
         Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
+        ja = limb.joints[2]
+        lim = sup.body.limits[ja]
         for _ in range(20):
-            deficit = sup.toe0 - _toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
+            deficit = -_toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
             low = free & (deficit > 1e-6)
             if not np.any(low):
                 break
-            # Bending the knee also tips the foot down: overshoot a little.
+            # Near the floor the free foot flexes towards flat, and the knee
+            # bends (which also tips the foot down: overshoot a little).
+            shin = Qf[low] @ _rot_x(limb.middle_angle(bf[low]))
+            flat = np.clip(euler_near(shin.transpose(0, 2, 1), 0.0, lim), lim[:, 0], lim[:, 1])
+            ankle[low, 0] = np.maximum(ankle[low, 0], flat[:, 0])
             floor_z[low] += 2.0 * deficit[low] + 1e-4
             Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
         out[f"{foot}_leg"] = (Qf, bf, ankle)

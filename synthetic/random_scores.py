@@ -12,10 +12,13 @@ exactly.  Guarantees (each is checked by ``tests/synthetic``):
   every symbol is a visible movement;
 * reachable: every gesture direction is within the joint extremes (no arm
   through the torso behind-low, no leg higher than the hip allows, no
-  gesture leg down at place low where it would stand on the floor).  This is
-  *verified*: the draw is interpreted and redrawn (same generator stream)
-  until :func:`synthetic.interpret.unreachable` is empty, so quantising the
-  interpreted joints gives back exactly the symbols.
+  gesture leg down at place low where it would stand on the floor; the head
+  within 40° of the chest).  This is *verified*: the draw is interpreted and
+  redrawn (same generator stream) until no
+  :class:`~synthetic.interpret.UnreachableWarning` is raised, so quantising
+  the interpreted joints gives back exactly the symbols.  No arm or head
+  symbol ends while the chest moves, and leg gestures never end while the
+  weight shifts, so the check holds at any frame rate.
 
 Supports follow a dancer's logic: both feet (plié, middle, relevé), a
 weight transfer onto one foot followed by gestures of the free leg and a
@@ -91,14 +94,26 @@ def _side(target, part):
     return (_mirror(d) if part.startswith("left") else d), lv, b
 
 
-def _gesture_track(rng, part, targets, t0, t1, with_bend=True):
-    """Symbols of one part between beats t0 and t1, with random holds."""
+def _moving(symbols, beat) -> bool:
+    """Whether any of `symbols` is mid-movement at `beat`."""
+    return any(s.start < beat < s.end for s in symbols)
+
+
+def _gesture_track(rng, part, targets, t0, t1, with_bend=True, chest=()):
+    """Symbols of one part between beats t0 and t1, with random holds.
+
+    No symbol ends while the `chest` moves: the arms hang from the chest, so
+    their reach at arrival then does not depend on the frame rate.
+    """
     out, t, last = [], Fraction(t0), None
     while True:
         t += _GAPS[int(rng.integers(len(_GAPS)))]
         dur = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
         if t + dur > t1:
             return out
+        if _moving(chest, t + dur):
+            t += dur
+            continue
         d, lv, b = _side(_pick(rng, targets, last), part)
         last = _side((d, lv, b), part)
         out.append(Symbol(t, dur, part, d, lv, b if with_bend else 0))
@@ -116,10 +131,10 @@ def _head_track(rng, chest, t1):
     from capture2notation.notation.directions import canonical_vector
 
     def chest_dir(beat):
+        if _moving(chest, beat):
+            return None
         d = np.array([0.0, 0.0, 1.0])
         for c in chest:
-            if c.start < beat < c.end:
-                return None
             if c.end <= beat:
                 d = canonical_vector(c.direction, c.level)
         return d
@@ -144,7 +159,7 @@ def _head_track(rng, chest, t1):
         t += dur
 
 
-def _split_arm_track(rng, side, t0, t1):
+def _split_arm_track(rng, side, t0, t1, chest=()):
     """Upper arm and forearm symbols over the same spans (elbow bend ≤ 120°)."""
     out, t, last = [], Fraction(t0), None
     upper = [x for x in ARM_TARGETS if x[2] == 0]
@@ -155,6 +170,9 @@ def _split_arm_track(rng, side, t0, t1):
         dur = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
         if t + dur > t1:
             return out
+        if _moving(chest, t + dur):
+            t += dur
+            continue
         u = _pick(rng, upper, last)
         v1 = canonical_vector(u[0], u[1])
         fore = [x for x in upper if np.degrees(np.arccos(np.clip(canonical_vector(x[0], x[1]) @ v1, -1, 1))) <= 120]
@@ -268,9 +286,9 @@ def random_score(
             elif p == "legs":
                 syms += _legs_track(rng, n_beats)
             elif p in ("right_arm", "left_arm") and split_arms:
-                syms += _split_arm_track(rng, p.split("_")[0], 0, n_beats)
+                syms += _split_arm_track(rng, p.split("_")[0], 0, n_beats, chest)
             elif p in ("right_arm", "left_arm"):
-                syms += _gesture_track(rng, p, ARM_TARGETS, 0, n_beats)
+                syms += _gesture_track(rng, p, ARM_TARGETS, 0, n_beats, chest=chest)
         bpm = Fraction(int(rng.integers(60, 121))) if tempo is None else Fraction(tempo)
         effort = None
         if random_effort:

@@ -36,12 +36,16 @@ from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS
 
-__all__ = ["MIN_ANGLE_DEG", "MIN_FRAMES", "ProgressCurve", "progress_curve"]
+__all__ = ["MIN_ANGLE_DEG", "MIN_FRAMES", "SNAP_S", "ProgressCurve", "progress_curve"]
 
 #: A movement whose direction turns by less than this is "held" (no curve).
 MIN_ANGLE_DEG = 5.0
 #: Fewest interior frames for a curve (the model has two shape parameters).
 MIN_FRAMES = 4
+#: Largest distance, seconds, at which a window end is moved onto a frame:
+#: half a frame of the virtual dancer's 25 Hz source, which starts and ends
+#: movements on the nearest frame.
+SNAP_S = 0.5 / 25.0
 
 
 @dataclass(frozen=True)
@@ -85,10 +89,11 @@ def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.arctan2(cross, np.einsum("ij,ij->i", np.broadcast_to(a, b.shape), b))
 
 
-def _snap(t: float, times: np.ndarray) -> float:
-    """Time of the frame nearest `t` (ties to the later frame)."""
+def _snap(t: float, times: np.ndarray, tol: float) -> float:
+    """Time of the frame nearest `t` (ties to the later frame) if within `tol` s, else `t`."""
     k = int(np.clip(np.searchsorted(times, t), 1, times.size - 1))
-    return float(times[k] if times[k] - t <= t - times[k - 1] + 1e-9 else times[k - 1])
+    near = float(times[k] if times[k] - t <= t - times[k - 1] + 1e-9 else times[k - 1])
+    return near if abs(near - t) <= tol + 1e-9 else float(t)
 
 
 def _circle_angle(u: np.ndarray) -> np.ndarray:
@@ -144,7 +149,7 @@ def progress_curve(
     t_end: float,
     joint_names=JOINTS,
     method: str = "circle",
-    snap: bool = True,
+    snap: float = SNAP_S,
 ) -> ProgressCurve | None:
     """Progress curve of `part` over the window [t_start, t_end] seconds.
 
@@ -165,11 +170,12 @@ def progress_curve(
         Names of the J joints.
     method : {"circle", "chord", "arc"}
         Measure of progress (module docstring).
-    snap : bool
-        Move the window's ends to the nearest frames (ties to the later one),
-        as the virtual dancer places a movement's key frames
-        (``synthetic.interpret.beat_frame``); otherwise the ends are
-        extrapolated from the nearest frames inside the window.
+    snap : float
+        Move a window end onto the nearest frame (ties to the later one) when
+        that frame is within `snap` seconds, as the virtual dancer places a
+        movement's key frames (``synthetic.interpret.beat_frame``); other
+        ends (e.g. in decimated captures) are extrapolated from the nearest
+        frames inside the window.  0 disables snapping.
 
     Returns
     -------
@@ -208,8 +214,8 @@ def progress_curve(
     conf = np.nan_to_num(conf, nan=0.0)
     ok = np.all(np.isfinite(rel), axis=1) & (conf > 0) & (np.linalg.norm(np.nan_to_num(rel), axis=1) > 1e-6)
 
-    if snap:
-        t_start, t_end = _snap(t_start, times), _snap(t_end, times)
+    if snap > 0:
+        t_start, t_end = _snap(t_start, times, snap), _snap(t_end, times, snap)
         if not t_end > t_start:
             raise EffortError(f"{where}: shorter than one frame")
     v0, _ = _endpoint(t_start, times, rel, conf, ok, where, +1)

@@ -37,9 +37,11 @@ FEATURES = ("time", "weight", "space", "log_tempo")
 PERFORMER_SD = (0.3, 0.05, 0.25, 0.1)
 
 #: Spread of the estimated features about their preset, per feature, fitted
-#: on the calibration set: RMS of (estimate − preset) over 200 seeded
-#: synthetic performances (seed 2005), from truth joints at 25 Hz.
-SPREAD = (0.2, 0.03, 0.15, 0.06)
+#: on the calibration set: RMS of (estimate − preset) over 120 seeded
+#: synthetic performances (30 per emotion, seed 2005, 4-symbol arm phrases
+#: by ``synthetic.interpret``, truth joints at 25 Hz), as printed by
+#: ``benchmarks/calibrate_effort.py --derive``.
+SPREAD = (0.2974, 0.0446, 0.1861, 0.1052)
 
 
 def preset_features() -> tuple[tuple[str, ...], np.ndarray]:

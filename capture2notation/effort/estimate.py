@@ -16,7 +16,7 @@ import numpy as np
 from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS, Score
-from .curves import ProgressCurve, progress_curve
+from .curves import SNAP_S, ProgressCurve, progress_curve
 from .emotion import emotion_probabilities, features
 from .fit import SpaceEstimate, fit_space
 from .pooled import PooledEffort, pool_curves
@@ -143,7 +143,7 @@ def estimate_effort(
     workers: int = 1,
     sampler_kw: dict | None = None,
     per_movement: bool = True,
-    snap: bool = True,
+    snap: float = SNAP_S,
 ) -> EffortResult:
     """Estimate Laban Effort per movement, pooled per part and phrase, and the emotion.
 
@@ -170,8 +170,9 @@ def estimate_effort(
     per_movement : bool
         Sample each movement's posterior (False: pooled estimates only, for
         studies that need the phrase's Effort alone).
-    snap : bool
-        Snap movement windows to frames (see :func:`.curves.progress_curve`).
+    snap : float
+        Snap window ends to frames within this many seconds (see
+        :func:`.curves.progress_curve`).
 
     Returns
     -------
@@ -212,7 +213,8 @@ def estimate_effort(
     by_part: dict[str, list] = {}
     for c in curves:
         by_part.setdefault(c.part, []).append(c)
-    groups = [(p, cs) for p, cs in by_part.items() if len(cs) >= 2]
+    # a part holding every measured movement pools to the phrase: sample once
+    groups = [(p, cs) for p, cs in by_part.items() if len(cs) >= 2 and len(cs) < len(curves)]
     if curves:
         groups.append(("phrase", curves))
 
@@ -243,6 +245,9 @@ def estimate_effort(
         tau, _, w, radial, _ = pool_curves(cs)
         pooled_all[label] = PooledEffort(label, len(cs), post, fit_space(tau, radial, w))
     phrase = pooled_all.pop("phrase", None)
+    if phrase is not None and len(by_part) == 1 and len(curves) >= 2:
+        (only,) = by_part
+        pooled_all[only] = PooledEffort(only, phrase.n_movements, phrase.posterior, phrase.space)
     tempo = float(score.tempo)
     emotion = None
     if phrase is not None:

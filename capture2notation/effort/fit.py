@@ -15,7 +15,7 @@ from scipy import optimize, stats
 from ..errors import EffortError
 from .model import TIME_RANGE, WEIGHT_RANGE, progress
 
-__all__ = ["LogisticFit", "SpaceEstimate", "fit_logistic", "fit_space", "INWARD_DEPTH"]
+__all__ = ["INWARD_DEPTH", "LogisticFit", "SpaceEstimate", "fit_logistic", "fit_space"]
 
 #: Depth of the inward Space modulation at S = 0 (Neagle eq. 5.5: 0.1·r).
 INWARD_DEPTH = 0.1

@@ -110,16 +110,14 @@ def log_probability(theta, tau, s, weight, onehot=None):
         return out
     # Gaussian integral over each (c_g, k_g): chi2 at their best values plus
     # the log-determinant of the 2x2 normal equations
-    if onehot.shape[1] == 1:  # one movement: plain sums are faster than the product
-        def gsum(x):
-            return np.sum(x, axis=-1, keepdims=True)
-    else:
-        def gsum(x):
-            return x @ onehot
     ws = weight * s
-    s0, s_s, s_ss = gsum(weight), gsum(ws), gsum(ws * s)  # (G,)
-    wm = weight * model
-    s_m, s_mm, s_sm = gsum(wm), gsum(wm * model), gsum(ws * model)  # (W', G)
+    if onehot.shape[1] == 1:  # one movement: matrix-vector products, (W', 1)
+        s0, s_s, s_ss = np.sum(weight), np.sum(ws), ws @ s
+        s_m, s_mm, s_sm = (model @ weight)[:, None], ((model * model) @ weight)[:, None], (model @ ws)[:, None]
+    else:
+        s0, s_s, s_ss = weight @ onehot, ws @ onehot, (ws * s) @ onehot  # (G,)
+        wm = weight * model
+        s_m, s_mm, s_sm = wm @ onehot, (wm * model) @ onehot, (ws * model) @ onehot  # (W', G)
     det = s0 * s_mm - s_m * s_m
     fit = (s_mm * s_s * s_s - 2.0 * s_m * s_s * s_sm + s0 * s_sm * s_sm) / det
     chi2 = np.sum(s_ss - fit, axis=1)
@@ -135,7 +133,7 @@ def sample_posterior(
     rng: np.random.Generator | int | None = None,
     groups=None,
     free_ends: bool = True,
-    nwalkers: int = 24,
+    nwalkers: int = 16,
     block: int = 100,
     max_steps: int = 6000,
     tau_rtol: float = 0.05,

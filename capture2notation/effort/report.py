@@ -21,7 +21,7 @@ from .estimate import EffortResult
 from .model import progress
 from .presets import PRESETS
 
-__all__ = ["EFFORT_JSON", "PROGRESS_PNG", "POOLED_PNG", "write_effort", "plot_progress", "plot_pooled"]
+__all__ = ["EFFORT_JSON", "POOLED_PNG", "PROGRESS_PNG", "plot_pooled", "plot_progress", "write_effort"]
 
 EFFORT_JSON = "effort.json"
 PROGRESS_PNG = "effort_progress.png"

@@ -1,4 +1,13 @@
-"""Fitting: 2D keypoints (or 3D joints) -> 3D joints, joint angles and confidences."""
+"""Fitting: keypoints or 3D joints -> joint angles of the body model, 3D joints, confidences.
+
+* :func:`fit_track` / :func:`fit_keypoints` — 2D BlazePose landmarks (plus
+  world landmarks) seen by a :class:`Camera` (known from a truth sidecar, or
+  a default one refined from the data) -> :class:`FitResult`;
+* :func:`fit_points3d` — measured 3D joints (BVH, Kinect) -> :class:`FitResult`;
+* :class:`FitOptions` — weights and iterations; :class:`PoseModel` — the
+  solver's parametrisation, FK and Jacobian; :func:`estimate_offsets` —
+  per-clip segment lengths.
+"""
 
 from .camera import DEFAULT_DISTANCE, DEFAULT_HEIGHT, DEFAULT_HFOV_DEG, Camera
 from .fit import fit_keypoints, fit_track, refine_focal

@@ -145,7 +145,7 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body) -> np.ndarray:
     ankle sits above our ankle joint) while the size stays the body's.
     """
     model0 = PoseModel(body)
-    depth = camera.to_camera(_initial_params(model0, camera, names, tx, tc, None)[:, :3])[:, 2]
+    depth = camera.to_camera(_initial_params(model0, camera, names, tx, tc, None, pose=False)[:, :3])[:, 2]
     ratio = np.full(_J, np.nan)
     base = np.linalg.norm(body.offsets, axis=1)
     for j, name in enumerate(JOINTS):
@@ -167,8 +167,14 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body) -> np.ndarray:
     return offsets_from_ratios(ratio, body, relative=True)
 
 
-def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw) -> np.ndarray:
-    """Root from the hip midpoint at a depth from the figure's scale; pelvis yaw facing as measured."""
+def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool = True) -> np.ndarray:
+    """Starting parameters of every frame.
+
+    The root is under the hip midpoint at a depth from the figure's image
+    scale; the pelvis faces as the hips say; with `pose`, the joint angles
+    come from :func:`~capture2notation.fitting.ik.initial_angles` on the
+    world landmarks, or on the 2D landmarks lifted by :func:`_lift`.
+    """
     T = tx.shape[0]
     n = model.n_params
     params = np.zeros((T, n))
@@ -212,19 +218,81 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw) -> np.ndar
         yaw = np.where(flip, yaw + np.pi, yaw)
     yaw = np.unwrap(fill(yaw, fallback=0.0))
     params[:, 3 + pelvis_axis(model, 2)] = yaw
+    if not pose:
+        return params
     if tw is not None:
         # World landmarks give 3D directions: start from their closed-form pose.
         pts = np.full((T, _J, 3), np.nan)
         for i, name in enumerate(names):
             if name in JOINTS:
                 pts[:, joint_index(name)] = np.where((tc[:, i] > 0)[:, None], tw[:, i] @ cam.R, np.nan)
-        ang = initial_angles(pts, model)
-        have = np.all(np.isfinite(pts[:, [joint_index("right_hip"), joint_index("left_hip")]]), axis=(1, 2))
-        ang[~have, 0] = 0.0
-        ang[~have, 0, 2] = yaw[~have]
-        ang[:, 0] = np.unwrap(ang[:, 0], axis=0)  # the pelvis turns freely: keep it continuous
-        params[:, 3:] = ang[:, model.dof_joint, model.dof_axis]
+    else:
+        pts = _lift(model, cam, names, tx, tc, root, yaw)
+    ang = initial_angles(pts, model)
+    have = np.all(np.isfinite(pts[:, [joint_index("right_hip"), joint_index("left_hip")]]), axis=(1, 2))
+    ang[~have, 0] = 0.0
+    ang[~have, 0, 2] = yaw[~have]
+    ang[:, 0] = np.unwrap(ang[:, 0], axis=0)  # the pelvis turns freely: keep it continuous
+    params[:, 3:] = ang[:, model.dof_joint, model.dof_axis]
     return params
+
+
+#: Chains lifted from 2D, parent target before child (see :func:`_lift`).
+_LIFT_CHAIN = (("pelvis", "neck"), ("neck", "right_shoulder"), ("neck", "left_shoulder"),
+               ("pelvis", "right_hip"), ("pelvis", "left_hip")) + tuple(
+    (f"{s}_{a}", f"{s}_{b}") for s in ("right", "left")
+    for a, b in (("shoulder", "elbow"), ("elbow", "wrist"), ("wrist", "hand_tip"),
+                 ("hip", "knee"), ("knee", "ankle"), ("ankle", "toe"))
+)
+
+
+def _lift(model: PoseModel, cam: Camera, names, tx, tc, root, yaw) -> np.ndarray:
+    """3D joints from 2D landmarks alone, for the starting pose.
+
+    Walking down the tree from the pelvis (at `root`), each joint is put on
+    its pixel's ray at the model's segment length from its parent; of the two
+    solutions the one in front of the performer is taken (dancers gesture
+    forward far more than backward), the closest point of the ray when the
+    image segment is longer than the model's, and for shins, which bend
+    either way.
+
+    Returns
+    -------
+    (T, J, 3) ndarray
+        World positions, NaN where a landmark is missing.
+    """
+    T = tx.shape[0]
+    rest = model.forward(np.zeros((1, model.n_params)))[0]
+    Kinv = np.linalg.inv(cam.K)
+    forward = np.stack([-np.sin(yaw), np.cos(yaw), np.zeros(T)], axis=1)
+    towards_camera = (forward @ cam.R.T)[:, 2] < 0  # forward points at the camera
+    cam_pts = {"pelvis": cam.to_camera(root)}
+    for a, b in _LIFT_CHAIN:
+        pa = cam_pts.get(a)
+        if pa is None:
+            continue
+        ib = names.index(b)
+        ray = np.concatenate([tx[:, ib], np.ones((T, 1))], axis=1) @ Kinv.T
+        L = np.linalg.norm(rest[model.index(b)] - rest[model.index(a)])
+        rr = np.sum(ray * ray, axis=1)
+        rp = np.sum(ray * pa, axis=1)
+        disc = rp**2 - rr * (np.sum(pa * pa, axis=1) - L**2)
+        root_d = np.sqrt(np.maximum(disc, 0.0))
+        # Lift only clearly foreshortened segments (image length under 0.8 of
+        # the model's): near the image plane the sign is a guess and the depth
+        # is mostly noise.  A knee bends either way (plié back, gesture
+        # forward), so shins are never lifted: the fit chooses.
+        l2 = np.sum((ray * (rp / rr)[:, None] - pa) ** 2, axis=1)
+        clear = l2 < (0.8 * L) ** 2
+        root_d = np.where(clear & (not b.endswith("_ankle")), root_d, 0.0)
+        lam = np.where(towards_camera, rp - root_d, rp + root_d) / rr
+        pb = ray * lam[:, None]
+        pb[tc[:, ib] <= 0] = np.nan
+        cam_pts[b] = pb
+    pts = np.full((T, _J, 3), np.nan)
+    for name, c in cam_pts.items():
+        pts[:, joint_index(name)] = (c - cam.t) @ cam.R
+    return pts
 
 
 def _check_2d(xy, confidence, world):

@@ -59,14 +59,23 @@ class FitOptions:
         Frames with fewer usable targets are returned as NaN.
     min_confidence : float
         Landmarks below this confidence are ignored.
+
+    Notes
+    -----
+    Defaults were set on the built-in phrases rendered at 640×480
+    (``benchmarks/bench_fitting.py``): BlazePose's world landmarks give
+    forearm and shin directions 15–20° off while its image landmarks are
+    within 1–3°, so the world prior is kept loose (``sigma_dir``) and
+    mostly decides in front / behind; a firm twist prior biased rounded
+    arms by ~5°, so the rest-pose pull is only a tie-breaker.
     """
 
     sigma_2d: float = 0.02
     sigma_dir: float = 0.18
     sigma_3d: float = 0.02
     sigma_smooth: float = 0.08
-    sigma_rest: float = 1.5
-    sigma_twist: float = 0.5
+    sigma_rest: float = 4.0
+    sigma_twist: float = 2.0
     huber: float = 2.0
     iterations: int = 20
     min_targets: int = 6

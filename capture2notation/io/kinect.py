@@ -30,7 +30,7 @@ from ..errors import MotionFileError
 from .atomic import write_text
 
 __all__ = ["KINECT_JOINTS", "KINECT_TO_JOINT", "TRACKING_CONFIDENCE", "read_kinect_csv",
-           "write_kinect_csv", "camera_to_world", "kinect_points"]
+           "write_kinect_csv", "camera_to_world", "world_to_camera", "kinect_points"]
 
 log = logging.getLogger(__name__)
 

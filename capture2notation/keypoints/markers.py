@@ -23,7 +23,7 @@ from ..errors import KeypointError
 from .blazepose import PoseEstimate
 from .track import NUM_LANDMARKS, landmark_index
 
-__all__ = ["MarkerSpec", "MarkerTracker", "default_markers", "detect_blobs"]
+__all__ = ["MarkerSpec", "MarkerTracker", "default_markers", "detect_blobs", "read_marker_specs"]
 
 
 @dataclass(frozen=True)
@@ -93,6 +93,45 @@ def default_markers(hue_tol: int = 4) -> list[MarkerSpec]:
         if joint in JOINT_TO_BLAZEPOSE:
             lo, hi = (int(h) - hue_tol) % 180, (int(h) + hue_tol) % 180
             specs.append(MarkerSpec(JOINT_TO_BLAZEPOSE[joint], (lo, 80, 60), (hi, 255, 255)))
+    return specs
+
+
+def read_marker_specs(path) -> list[MarkerSpec]:
+    """Marker colours from a JSON file, for gloves or tape on real footage.
+
+    The file holds a list of objects, each with ``"landmark"`` (BlazePose name
+    or index) and either ``"hsv_low"`` / ``"hsv_high"`` (OpenCV HSV, H < 180)
+    or ``"bgr"`` (a colour, matched at hue ± ``"hue_tol"``, default 6)::
+
+        [{"landmark": "left_wrist", "hsv_low": [50, 80, 60], "hsv_high": [70, 255, 255]},
+         {"landmark": "right_wrist", "bgr": [0, 0, 220]}]
+
+    Raises
+    ------
+    KeypointError
+        Unreadable file or a bad entry (the message names the entry).
+    """
+    import json
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        entries = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise KeypointError(f"{path}: cannot read marker colours: {exc}") from exc
+    if not isinstance(entries, list) or not entries:
+        raise KeypointError(f"{path}: expected a non-empty JSON list of markers")
+    specs = []
+    for k, e in enumerate(entries):
+        try:
+            lm = e["landmark"]
+            index = landmark_index(lm) if isinstance(lm, str) else int(lm)
+            if "bgr" in e:
+                specs.append(MarkerSpec.from_colour(index, e["bgr"], hue_tol=int(e.get("hue_tol", 6))))
+            else:
+                specs.append(MarkerSpec(index, tuple(e["hsv_low"]), tuple(e["hsv_high"])))
+        except (KeyError, TypeError, ValueError, KeypointError) as exc:
+            raise KeypointError(f"{path}: marker entry {k} ({e!r}): {exc}; expected landmark and hsv_low/hsv_high or bgr") from exc
     return specs
 
 

@@ -5,7 +5,9 @@ in a normal form (:func:`normalise`): a gesture symbol that moves a part to
 where it already is (its default standing pose or its previous destination)
 changes nothing and is dropped; an upper-arm and a forearm (thigh and shin)
 symbol over the same span pointing the same way are the straight whole limb; so is a support symbol that keeps the same
-feet at the same level in place.  The support parts (``support``,
+feet at the same level in place, and overlapping per-foot supports
+(Wolofsky's 1974 style, ``0 4 right_support`` with ``0 1 left_support``)
+become the transition they describe (``0 1 right_support``).  The support parts (``support``,
 ``right_support``, ``left_support``) form one column, ``supports``, whose
 state is (part, direction, level).
 
@@ -72,12 +74,34 @@ def _join_straight_limbs(symbols) -> list:
     return [s for s in syms if id(s) not in drop] + add
 
 
+def _support_transitions(symbols) -> list:
+    """Rewrite overlapping per-foot support symbols (Wolofsky's style: each
+    foot's symbol lasts while it supports) as transitions: when one foot's
+    symbol ends while the other's continues, the weight has moved onto the
+    other foot over the ended symbol's span."""
+    syms = list(symbols)
+    feet = [s for s in syms if s.part in ("right_support", "left_support")]
+    out = [s for s in syms if s not in feet]
+    used = set()
+    for s in feet:
+        for t in feet:
+            if t.part != s.part and t.start <= s.start and s.end < t.end and id(s) not in used:
+                # s ends first while t still supports: weight onto t's foot.
+                used.add(id(s))
+                if t.start < s.start:
+                    continue
+                used.add(id(t))
+                out.append(Symbol(s.start, s.duration, t.part, t.direction, t.level, 0))
+    out += [s for s in feet if id(s) not in used]
+    return out
+
+
 def normalise(score: Score) -> Score:
     """The normal form of `score` used for comparison (see module docstring)."""
     state = dict(DEFAULT_STATE)
     out: list[Symbol] = []
     support = DEFAULT_SUPPORT
-    for s in sorted(_join_straight_limbs(score.symbols), key=Symbol.sort_key):
+    for s in sorted(_support_transitions(_join_straight_limbs(score.symbols)), key=Symbol.sort_key):
         if s.is_support:
             key = (s.part, s.direction, s.level)
             if s.direction == "place" and key == support:

@@ -143,6 +143,9 @@ def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> tuple[
             # so the first and last frames of a stance are not dropped.
             speed[:-1] = step
             speed[1:] = np.fmin(speed[1:], step)
+            # Nothing follows the last frame: a foot that reaches the floor
+            # there has landed (a movement arrives at its last frame).
+            speed[-1] = 0.0
         else:
             speed[:] = 0.0
         sup = (low < SUPPORT_HEIGHT_M) & (speed < SUPPORT_SPEED_MS)

@@ -1,28 +1,46 @@
 """Movement segmentation: joints over time → a :class:`~capture2notation.notation.Score`.
 
-Each channel (a whole arm or leg, the head, the chest, each supporting foot)
-has an angular speed per frame interval.  A movement is a run of intervals
-where that speed exceeds a low threshold and peaks above a high one
-(hysteresis), widened outward while the speed keeps falling (so its ends sit
-at the speed minima that bracket it) and split at deep interior minima
-(back-to-back movements: the virtual dancer's logistic starts from zero
-speed).  Its symbol is the part's label where it arrives; its start and
-duration are snapped to the beat grid.
+Each channel — a whole arm or leg (its bound → free vector and its reach),
+the head, the chest, the supporting system (:mod:`.supports`) — has a speed
+per frame interval.  Movements are runs of motion (:mod:`.spans`); each
+becomes a symbol whose label is the part's pose where it arrives, its start
+and duration snapped to the beat grid (tempo given, or :func:`estimate_tempo`).
+
+Two regimes, chosen from the measured jitter:
+
+Clean motion (the virtual dancer's truth; jitter ≤ 0.05°/frame)
+    Not smoothed.  A hold is exactly still, so any motion belongs to a
+    movement, and back-to-back movements part only where the part is exactly
+    (0.05°) on a written pose — a canonical direction and a bend of 30°
+    steps — at a frame of the beat grid, having moved ≥ 5° since the last
+    boundary.  Speed minima alone are not trusted: a limb turning about a
+    fixed axis slows down mid-way, and the Space modulation makes the reach
+    dip and recover.  This recovers the written symbols exactly whenever the
+    dancer reaches its written poses.
+
+Noisy motion (fitted, mocap)
+    Savitzky–Golay smoothing over 0.3–0.6 s (wider for more jitter); a
+    movement exceeds the jitter's 99th-percentile speed and peaks above
+    ``peak_speed_deg_s`` (hysteresis), splits at interior minima deeper than
+    ``split_ratio``, keeps where it exceeds a tenth of its peak, must move
+    ``min_amplitude_deg``; key times of different parts within
+    ``merge_window_s`` are pulled together.
 
 Whole limb or segments
-    Arms and legs are written as whole limbs (``right_arm`` …) with the
-    bend degree of the elbow / knee.  A movement is written with segment parts
-    instead (``right_forearm`` / ``right_shin``) when the upper segment stays
-    still (its own angular displacement below ``min_amplitude_deg``) while
-    the lower one moves, i.e. when the two segments move independently; the
-    limb is then described by its segments until a whole-limb movement moves
-    both again.
+    Arms and legs are written as whole limbs (``right_arm`` …) with the bend
+    degree of the elbow / knee, unless the segments move independently: the
+    upper segment stays still while the lower one moves (a ``right_forearm`` /
+    ``right_shin`` symbol), or — clean motion — the bent limb arrives with
+    both segments nearer their written directions than the whole limb is to
+    its own (``upper_arm`` + ``forearm`` symbols over one span).  A whole-limb
+    symbol puts the whole limb exactly on its direction; its segments are
+    almost never both on written directions.  :func:`~.agreement.normalise`
+    treats an upper + lower pair pointing one way as the straight whole limb.
 
 Supports
-    See :mod:`.supports`: the weight-bearing feet and their level, segmented
-    on the pelvis's and the supporting legs' speed; a weight-bearing foot
-    that travelled is a step.  Legs write gestures only while their foot is
-    off the floor (a leg that lands is part of a support).
+    See :mod:`.supports`: the weight-bearing feet and their level; a
+    weight-bearing foot that travelled is a step.  Legs write gestures only
+    while their foot is off the floor (a leg that lands is part of a support).
 """
 
 from __future__ import annotations
@@ -38,6 +56,7 @@ from ..errors import QuantiseError
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
 from .labels import DIRECTION_NAMES, FrameLabels, label_frames
+from .spans import _ZERO_SPEED, movement_spans
 from .supports import support_movements
 from .tempo import estimate_tempo, snap
 
@@ -53,14 +72,15 @@ class SegmentParams:
     grid : Fraction
         Beat grid for starts and durations (default ¼ beat).
     smooth_s : float or None
-        Savitzky–Golay window, seconds; ``None`` chooses it from the noise
-        (no smoothing for clean, e.g. synthetic, motion), 0 disables.
+        Savitzky–Golay window, seconds; ``None`` chooses it from the measured
+        jitter (none for clean, e.g. synthetic, motion; 0.3–0.6 s otherwise,
+        with thresholds above the jitter's speed).  Setting it forces the
+        noisy-motion path.
     min_speed_deg_s : float
-        Floor of the low (onset) speed threshold, degrees per second.
+        Floor of the low (onset) speed threshold of noisy motion, degrees per
+        second (clean motion: any motion at all).
     peak_speed_deg_s : float
         A movement must peak above this speed, degrees per second.
-    noise_k : float
-        Thresholds are at least this many noise speeds.
     min_amplitude_deg : float
         Smallest angular displacement that counts as a movement, degrees.
     split_ratio : float
@@ -75,7 +95,6 @@ class SegmentParams:
     smooth_s: float | None = None
     min_speed_deg_s: float = 2.0
     peak_speed_deg_s: float = 20.0
-    noise_k: float = 4.0
     min_amplitude_deg: float = 10.0
     split_ratio: float = 0.35
     merge_window_s: float = 0.3
@@ -134,9 +153,6 @@ _LIMBS = {
 _SINGLE = ("head", "chest")
 _DEFAULT = {"head": ("place", "high"), "chest": ("place", "high")}
 _FOOT = {"right_leg": 0, "left_leg": 1}
-#: Speeds below this (degrees per second) are rounding noise of a hold, not
-#: movement; a sudden Effort's first frame still moves far more.
-_ZERO_SPEED = 1e-6
 #: Jitter (degrees per frame) below which motion counts as clean (the
 #: virtual dancer's truth measures ≤ 0.02°, optical mocap ≥ 0.1°): not
 #: smoothed, and split only at exactly written poses.
@@ -183,118 +199,6 @@ def _smooth(u: np.ndarray, window: int) -> np.ndarray:
     s /= np.linalg.norm(s, axis=-1, keepdims=True)
     s[bad] = np.nan
     return s
-
-
-def movement_spans(
-    speed: np.ndarray, low: float, high: float, split_ratio: float, key_pose=None
-) -> list[tuple[int, int]]:
-    """Movements in a per-interval speed signal.
-
-    Parameters
-    ----------
-    speed : (N,) ndarray
-        Speed over each frame interval (interval i spans frames i → i+1);
-        NaN counts as still.
-    low, high : float
-        Hysteresis thresholds: a run above `low` is a movement if it peaks
-        above `high`.
-    split_ratio : float
-        See :class:`SegmentParams`.
-    key_pose : callable, optional
-        ``key_pose(frame, since) -> bool`` with attribute ``on_grid`` (see
-        :func:`_key_pose_fn`).  When given (clean motion), a run is split at
-        the local speed minima it accepts, however shallow, and never
-        elsewhere — a limb passing near its turning axis slows down
-        mid-movement without arriving anywhere.
-
-    Returns
-    -------
-    list of (a, b)
-        Interval index ranges, inclusive: the movement leaves the pose of
-        frame ``a`` and arrives at the pose of frame ``b + 1``.
-    """
-    s = np.nan_to_num(np.asarray(speed, dtype=float), nan=0.0)
-    n = s.size
-    above = s > low
-    spans: list[tuple[int, int]] = []
-    if not above.any():
-        return spans
-    edges = np.flatnonzero(np.diff(np.r_[0, above.astype(int), 0]))
-    runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
-    taken = np.zeros(n, bool)
-    for a, b in runs:
-        if s[a : b + 1].max() <= high:
-            continue
-        # Widen down the speed slope to the bracketing minima; a frame interval
-        # with no motion at all (a hold) stops the walk.
-        while a > 0 and not taken[a - 1] and _ZERO_SPEED < s[a - 1] <= s[a] and not above[a - 1]:
-            a -= 1
-        while b < n - 1 and _ZERO_SPEED < s[b + 1] <= s[b] and not above[b + 1]:
-            b += 1
-        taken[a : b + 1] = True
-        if key_pose is None:
-            spans.extend(_split(s, a, b, split_ratio, high))
-        else:
-            spans.extend(_split_at_key_poses(s, a, b, low, key_pose))
-    return spans
-
-
-def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> list[tuple[int, int]]:
-    """Split [a, b] where the motion passes a written pose.
-
-    With a beat grid every grid frame accepted by ``key_pose`` is a boundary;
-    without, only such frames next to a local speed minimum (a minimum in
-    interval m puts the boundary at frame m, the next movement's first
-    interval, or m + 1, this movement's last).
-    """
-    cuts = []
-    if key_pose.on_grid:
-        for f in range(a + 1, b + 1):
-            if key_pose(f, cuts[-1] if cuts else a):
-                cuts.append(f)
-    else:
-        for m in range(a + 1, b):
-            if not (s[m] <= s[m - 1] and s[m] <= s[m + 1]):
-                continue
-            for f in (m, m + 1):
-                if a < f <= b and (not cuts or f > cuts[-1]) and key_pose(f, cuts[-1] if cuts else a):
-                    cuts.append(f)
-                    break
-    bounds = [a] + cuts + [b + 1]
-    out = []
-    start = None
-    for lo, hi in zip(bounds[:-1], bounds[1:]):
-        start = lo if start is None else start
-        # A slow-starting movement (a sudden Effort) stays on its start pose
-        # for a few frames: those pieces belong to the movement that follows.
-        if s[lo:hi].max() > low:
-            out.append((start, hi - 1))
-            start = None
-    if start is not None and out:
-        out[-1] = (out[-1][0], b)
-    return out
-
-
-def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float) -> list[tuple[int, int]]:
-    """Split interval range [a, b] at its deepest qualifying interior minimum, recursively."""
-    if b - a < 2:
-        return [(a, b)]
-    seg = s[a : b + 1]
-    i = np.arange(1, seg.size - 1)
-    is_min = (seg[i] <= seg[i - 1]) & (seg[i] <= seg[i + 1])
-    best, best_depth = None, None
-    for k in i[is_min]:
-        left, right = seg[:k].max(), seg[k + 1 :].max()
-        if min(left, right) <= high:
-            continue
-        depth = seg[k] / min(left, right)
-        if depth < ratio and (best_depth is None or depth < best_depth):
-            best, best_depth = k, depth
-    if best is None:
-        return [(a, b)]
-    m = a + int(best)
-    # The minimum interval holds the boundary: it closes the first movement.
-    return _split(s, a, m, ratio, high) + _split(s, m + 1, b, ratio, high)
 
 
 def _interval_speed(u_list: list[np.ndarray], x_list: list[np.ndarray], fps: float) -> np.ndarray:
@@ -380,10 +284,11 @@ def segment_motion(
     if T < 2:
         raise QuantiseError(f"need at least 2 frames to segment a motion, got {T}")
     joints = np.asarray(joints, dtype=float)
-    supports = support_movements(labels, joints, fps, params, movement_spans)
     estimated = tempo is None
     if estimated:
-        moves = _gesture_movements(labels, joints, fps, params) + supports
+        moves = _gesture_movements(labels, joints, fps, params) + support_movements(
+            labels, joints, fps, params, movement_spans
+        )
         times = np.array([t for m in moves for t in (m.start_time, m.end_time)])
         if len(moves) == 0:
             # Nothing moves: the (empty) score needs some tempo; say so, invent nothing else.
@@ -391,12 +296,19 @@ def segment_motion(
             tempo, estimated = Fraction(60), False
         else:
             gestures = [m.end_time - m.start_time for m in moves if not m.part.endswith("support")]
-            tempo = estimate_tempo(times, params.grid, durations=gestures or None)
+            # Clean key times are within half a frame of their grid time;
+            # measured ones (smoothed, noisy) within a couple of frames.
+            clean = all(_noise_deg(labels.vectors[:, labels.index(p)]) <= _CLEAN_NOISE_DEG for p in _LIMBS)
+            tol = (0.6 if clean else 2.0) / fps
+            tempo = estimate_tempo(times, params.grid, tolerance_s=tol, durations=gestures or None)
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
     if tempo <= 0:
         raise QuantiseError(f"tempo must be > 0 beats per minute, got {tempo}")
     # With the beat grid known, clean motion is cut only on its frames.
-    moves = _gesture_movements(labels, joints, fps, params, _grid_frames(T, fps, tempo, params.grid)) + supports
+    on_grid = _grid_frames(T, fps, tempo, params.grid)
+    moves = _gesture_movements(labels, joints, fps, params, on_grid) + support_movements(
+        labels, joints, fps, params, movement_spans, on_grid
+    )
     moves.sort(key=lambda m: (m.start_time, m.part))
     merged = _merge_times(moves, params, float(tempo))
     symbols = _symbols(merged, tempo, params.grid)
@@ -525,9 +437,9 @@ def _limb_symbols(labels: FrameLabels, part: str, start_f: int, end_f: int, fram
     The whole limb is written (with its bend) unless the segments move
     independently: the upper segment stays still while the lower one moves
     (a forearm / shin symbol), or — clean motion only — the bent limb arrives
-    with both segments on written directions (upper-arm and forearm symbols
-    over the same span; a whole-limb symbol with a bend puts the upper
-    segment off the written directions except by coincidence).
+    with both segments nearer their written directions than the whole limb
+    is to its own (upper-arm and forearm symbols over the same span; a
+    whole-limb symbol puts the whole limb exactly on its direction).
 
     Returns
     -------
@@ -543,11 +455,12 @@ def _limb_symbols(labels: FrameLabels, part: str, start_f: int, end_f: int, fram
         return [(_LIMBS[part][1], d2, lv2)]
     if not clean:
         return None
-    tol = 0.05
     bend = float(np.nanmean(labels.bend_deg[frames, whole]))
     # A bent whole limb almost never has both segments on written directions,
-    # so two written segments mean the segments were written.
-    if bend < tol or _off_canonical_deg(labels, upper, frames) >= tol or _off_canonical_deg(labels, lower, frames) >= tol:
+    # so segments nearer their written directions than the whole limb is to
+    # its own mean the segments were written.
+    segs_off = max(_off_canonical_deg(labels, upper, frames), _off_canonical_deg(labels, lower, frames))
+    if bend < 0.05 or not segs_off < _off_canonical_deg(labels, whole, frames):
         return None
     d1, lv1, _ = _label_at(labels, upper, frames)
     return [(_LIMBS[part][0], d1, lv1), (_LIMBS[part][1], d2, lv2)]

@@ -21,7 +21,10 @@ the body frame (a step).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
+from scipy.signal import savgol_filter
 
 from ..body import joint_index
 from ..notation.directions import bend_angle, classify_indices
@@ -103,17 +106,67 @@ def _support_speed(labels: FrameLabels, joints: np.ndarray, fps: float) -> np.nd
     return np.linalg.norm(np.diff(x, axis=0), axis=1) * fps
 
 
-def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, params, spans_fn) -> list:
-    """Support movements as :class:`~.segment.Movement` objects (see the module docstring)."""
+def _position_noise(joints: np.ndarray) -> float:
+    """Jitter of the pelvis and feet, metres (lower quartile of the local-cubic residual; 0 when clean)."""
+    idx = [joint_index(n) for n in ("pelvis", "right_ankle", "left_ankle")]
+    p = joints[:, idx].reshape(joints.shape[0], -1)
+    ok = np.isfinite(p).all(axis=1)
+    if ok.sum() < 7:
+        return 0.0
+    r = np.abs(p[ok] - savgol_filter(p[ok], 5, 3, axis=0))
+    return float(np.percentile(r, 25) / 0.23)
+
+
+def _mode_filter(x: np.ndarray, width: int) -> np.ndarray:
+    """Most frequent value in a centred window of `width` frames (ties: the current value)."""
+    if width < 3:
+        return x
+    h = width // 2
+    pad = np.r_[np.full(h, x[0]), x, np.full(h, x[-1])]
+    win = np.lib.stride_tricks.sliding_window_view(pad, width)
+    vals = np.unique(x)
+    counts = np.stack([(win == v).sum(axis=1) for v in vals], axis=1)
+    best = vals[np.argmax(counts, axis=1)]
+    keep = counts[np.arange(len(x)), np.searchsorted(vals, x)] == counts.max(axis=1)
+    return np.where(keep, x, best)
+
+
+def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, params, spans_fn,
+                      on_grid: np.ndarray | None = None) -> list:
+    """Support movements as :class:`~.segment.Movement` objects (see the module docstring).
+
+    Noisy motion (jitter above 1 mm) is smoothed over 0.3 s first, and the
+    support state is mode-filtered over 0.3 s, so contact flicker does not
+    write symbols.
+    """
+    from .labels import support_frames
     from .segment import Movement
 
     T = joints.shape[0]
+    noise = _position_noise(joints)
+    noisy = noise > 1e-3
+    if noisy and T > 9:
+        w = max(5, int(round(0.3 * fps)) | 1)
+        if T > w:
+            filled = np.where(np.isfinite(joints), joints, np.nanmedian(joints, axis=0))
+            joints = savgol_filter(filled, w, 2, axis=0)
+            sup, lev = support_frames(joints, fps)
+            labels = replace(labels, supporting=sup, support_level=lev)
     part, level = support_state(labels, joints)
+    if noisy:
+        w = max(3, int(round(0.3 * fps)) | 1)
+        code = _mode_filter((part + 1) * 4 + (level + 1), w)
+        part, level = code // 4 - 1, code % 4 - 1
     speed = _support_speed(labels, joints, fps)
-    noise = float(np.nanmedian(np.abs(np.diff(speed)))) if speed.size > 2 else 0.0
-    low = max(params.min_speed_deg_s, params.noise_k * noise)
-    high = max(params.peak_speed_deg_s, 2.0 * low)
-    spans = spans_fn(speed, low, high, params.split_ratio)
+    if noisy:
+        low = max(params.min_speed_deg_s, 4.0 * float(np.nanpercentile(speed, 25)))
+        high = max(params.peak_speed_deg_s, 2.0 * low)
+        spans = spans_fn(speed, low, high, params.split_ratio)
+    else:
+        # Clean motion: any motion is a movement; back-to-back support
+        # symbols part at grid frames with both feet down and the speed at a
+        # local minimum (never mid-step, while a foot is in the air).
+        spans = spans_fn(speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid))
     height = _body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
     out = []
@@ -133,6 +186,28 @@ def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, param
         state = new
         out.append(Movement(_SUPPORT_PARTS[new[0]], a, end, a / fps, (b + 1) / fps, direction, LEVELS[new[1]], 0))
     return out
+
+
+def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None):
+    """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements."""
+    down = labels.supporting.all(axis=1)
+    n = speed.size
+
+    def key(f: int, since: int) -> bool:
+        if not down[f] or (on_grid is not None and not on_grid[f]):
+            return False
+        # A deep local speed minimum in the interval just before or after f
+        # (below a third of the peaks within a second on either side).
+        w = 25
+        for m in (f - 1, f):
+            if 0 < m < n - 1 and speed[m] <= speed[m - 1] and speed[m] <= speed[m + 1]:
+                left, right = speed[max(0, m - w) : m].max(), speed[m + 1 : m + 1 + w].max()
+                if speed[m] <= 0.35 * min(left, right):
+                    return True
+        return False
+
+    key.on_grid = on_grid is not None
+    return key
 
 
 def _body_height(joints: np.ndarray) -> float:

@@ -16,9 +16,17 @@ from capture2notation.keypoints import BACKENDS, extract
 @click.option("--fps", type=float, default=None, help="Frame rate of an image folder (default 30).")
 @click.option("--threads", type=int, default=2, show_default=True, help="onnxruntime threads.")
 @click.option("--no-smooth", is_flag=True, help="Disable the one-euro temporal filter.")
-def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth):
+@click.option("--markers", "markers_file", type=click.Path(exists=True, dir_okay=False), default=None, help="JSON marker colours for --backend markers (default: the renderer's).")
+def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, markers_file):
     """Extract 33 BlazePose keypoints per frame from VIDEO (file or image folder)."""
-    track = extract(video, backend, model=model, fps=fps, threads=threads, smooth=not no_smooth, progress=True)
+    markers = None
+    if markers_file:
+        from capture2notation.keypoints.markers import read_marker_specs
+
+        markers = read_marker_specs(markers_file)
+    track = extract(
+        video, backend, model=model, fps=fps, threads=threads, smooth=not no_smooth, markers=markers, progress=True
+    )
     track.save(output)
     seen = float((track.presence > 0).mean()) if len(track) else 0.0
     click.echo(f"{output}: {len(track)} frames at {track.fps:g} fps, person found in {100 * seen:.0f}% of frames")

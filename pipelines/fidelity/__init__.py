@@ -19,6 +19,8 @@ CAPTURE_NOTES = {
     "keypoints": "keypoint path — the dancer's 33 BlazePose landmarks projected into each camera with self-occlusion, "
                  "jittered and rounded to pixels, then fitted in 3D by capture2notation.fitting (no image and no "
                  "pose detector; compression not modelled)",
+    "video": "video path — the renderer draws each take, the kept frames are held in between, JPEG-compressed and "
+             "noised, and c2n capture (BlazePose, fitting, segmentation) reads the video",
 }
 
 

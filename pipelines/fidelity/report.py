@@ -10,8 +10,8 @@ Experiment 2 78.99 % overall, same pairs angry 86.46 %, happy 71.88 %, sad
 from __future__ import annotations
 
 import math
+import os
 from collections import defaultdict
-from fractions import Fraction
 
 import numpy as np
 
@@ -267,7 +267,11 @@ def write_report(result, outdir, capture_note: str = "") -> str:
     rep.paragraph(
         f"{jobs.get('total', 0)} jobs ({jobs.get('ran', 0)} run now, {jobs.get('cached', 0)} from the cache, "
         f"{jobs.get('failed', 0)} failed); seed {cfg.get('seed')}; capture path '{summ.get('capture')}'; "
-        f"wall time {result.wall_seconds:.0f} s."
+        f"wall time of this run {result.wall_seconds:.0f} s on {os.cpu_count()} cores "
+        f"(load average {os.getloadavg()[0]:.1f} at the end; cached jobs cost nothing); the jobs took "
+        f"{jobs.get('job_seconds', float('nan')):.0f} s in all when they ran (each job's wall time, at whatever "
+        f"load the machine had), i.e. about "
+        f"{jobs.get('job_seconds', float('nan')) / max(os.cpu_count() or 1, 1) / 60:.1f} min on {os.cpu_count()} cores."
     )
     note = (
         f"How this study captured the performances: {capture_note or summ.get('capture')}. The virtual dancer "

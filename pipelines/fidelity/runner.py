@@ -46,7 +46,7 @@ __all__ = ["STUDY_VERSION", "resolve_capture", "run_condition", "run_study", "St
 log = logging.getLogger(__name__)
 
 #: Bumped when the measurement changes, so cached jobs are recomputed.
-STUDY_VERSION = f"{__version__}-fidelity-1"
+STUDY_VERSION = f"{__version__}-fidelity-3"
 
 #: Capture paths without images (compression cannot be applied).
 IMAGE_FREE = ("truth", "keypoints")
@@ -81,7 +81,7 @@ def run_condition(job: Job, seed: int, capture_mode="truth", fps: float = 25.0, 
     seed : int
         Study seed.
     capture_mode : str or callable
-        ``"truth"``, ``"keypoints"``, or a function ``(motion, kept, condition,
+        ``"truth"``, ``"keypoints"``, ``"video"``, or a function ``(motion, kept, condition,
         rng) -> (joints (T,J,3), confidence (T,J))`` (the pluggable capture).
     fps : float
         The virtual dancer's frame rate.
@@ -107,7 +107,7 @@ def run_condition(job: Job, seed: int, capture_mode="truth", fps: float = 25.0, 
         if callable(capture_mode):
             joints, conf = capture_mode(motion, kept, c, rng)
         else:
-            joints, conf = capture(capture_mode, motion, kept, c, rng)
+            joints, conf = capture(capture_mode, motion, kept, c, rng, score)
         row.update(measure(score, motion, joints, conf, kept, rng, bootstrap))
         row["error"] = ""
     except C2NError as exc:
@@ -136,7 +136,7 @@ def _cache_path(outdir: Path, job: Job, cfg: StudyConfig, mode: str) -> Path:
     return outdir / "cache" / f"{job.digest(cfg, mode, STUDY_VERSION)}.json"
 
 
-def _execute(pending, cfg, mode, scheduler, workers, progress):
+def _execute(pending, cfg, mode, scheduler, workers, progress, timeout=20.0):
     """Yield (job, row) as jobs finish, locally or on a Dask cluster."""
     from tqdm import tqdm
 
@@ -148,7 +148,7 @@ def _execute(pending, cfg, mode, scheduler, workers, progress):
             from dask.distributed import as_completed as dask_completed
 
             try:
-                client = Client(scheduler, timeout="20s")
+                client = Client(scheduler, timeout=f"{timeout}s")
             except (OSError, TimeoutError) as exc:
                 raise PipelineError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}") from None
             try:
@@ -174,7 +174,7 @@ def _execute(pending, cfg, mode, scheduler, workers, progress):
 
 
 def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: int | None = None,
-              progress: bool = True) -> StudyResult:
+              progress: bool = True, connect_timeout: float = 20.0) -> StudyResult:
     """Run (or resume) a study and write ``results.csv``, ``trials.csv`` and ``summary.json``.
 
     Parameters
@@ -187,6 +187,8 @@ def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: i
         Local processes (default: the number of cores).
     progress : bool
         Show a tqdm progress bar.
+    connect_timeout : float
+        Seconds to wait for the Dask scheduler.
     """
     t0 = time.perf_counter()
     outdir = Path(outdir)
@@ -215,7 +217,7 @@ def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: i
         pending.append(j)
     log.info("%d jobs, %d cached, %d to run (capture=%s)", len(jobs), len(jobs) - len(pending), len(pending), mode)
     workers = workers or os.cpu_count() or 1
-    for j, row in _execute(pending, cfg, mode, scheduler, workers, progress):
+    for j, row in _execute(pending, cfg, mode, scheduler, workers, progress, connect_timeout):
         write_text(_cache_path(outdir, j, cfg, mode), json.dumps(row, sort_keys=True, default=_json_default))
         rows_by_job[j] = row
     # Condition identity (not its factor label) keys the cache; restore the label here.
@@ -231,7 +233,8 @@ def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: i
     summary["config"] = cfg.as_dict()
     summary["capture"] = mode
     summary["jobs"] = {"total": len(jobs), "ran": len(pending), "cached": len(jobs) - len(pending),
-                       "failed": sum(1 for r in rows if r.get("error"))}
+                       "failed": sum(1 for r in rows if r.get("error")),
+                       "job_seconds": float(sum(r.get("seconds", 0.0) for r in rows))}
     write_text(outdir / "summary.json", json.dumps(summary, indent=2, sort_keys=True, default=_json_default))
     return StudyResult(rows, trials, summary, conditions, wall)
 

@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 
 from capture2notation.body import joint_index
+from capture2notation.body.landmarks import attached_points
 
 from .camera import Camera
 from .scene import CAPSULES, HEAD_RADII, Pose, body_capsules, floor_background
@@ -69,6 +70,8 @@ _TROUSER_RINGS = (
     ("pelvis", 0.470, 0.098, 0.062),
 )
 _RING_POINTS = 10
+# V-neck of the shirt: collar corners and the point of the V (rest, fractions of H).
+_COLLAR = ((-0.046, 0.040, 0.836), (0.046, 0.040, 0.836), (0.0, 0.062, 0.766))
 # Head ellipses: (scale, shift towards the light in semi-axes).
 _HEAD_LAYERS = ((1.0, 0.0), (0.86, 0.10), (0.45, 0.35))
 _FACE_POINTS = ("left_eye", "right_eye", "nose", "mouth_left", "mouth_right", "left_ear", "right_ear",
@@ -192,6 +195,8 @@ class Mannequin:
         self._hull_depth = np.stack([camera.depth(pose.joints[:, chest]), camera.depth(pose.joints[:, pelvis])], 1)
         self._hull_colour = [[_gain(PALETTE[c], g) for _, _, g in _HULL_LAYERS] for c in ("shirt", "trousers")]
         self._head = self._head_geometry()
+        self._collar, self._collar_seen = self._collar_geometry()
+        self._collar_colour = _gain(PALETTE["skin"], 0.9)
         skin, hair = PALETTE["skin"], PALETTE["hair"]
         self._head_colours = {
             "skin": skin, "skin_rim": _gain(skin, 0.62), "skin_light": _gain(skin, 1.08),
@@ -286,6 +291,17 @@ class Mannequin:
         out["mouth_pts"] = (fixed(pts["mouth_left"]).tolist(), fixed(pts["mouth_right"]).tolist())
         return out
 
+    def _collar_geometry(self) -> tuple[np.ndarray, list]:
+        """A V-neck at the front of the shirt (a front/back cue), (T, 3, 2) fixed points, seen flags."""
+        pose, H = self.pose, self.pose.body.height
+        chest = joint_index("chest")
+        rest = np.array(_COLLAR) * H - pose.body.rest[chest]
+        world = attached_points(pose.joints, pose.rotations, [chest] * 3, rest)
+        front = pose.rotations[:, chest, :, 1]  # the chest's forward axis
+        to_cam = self.camera.position - world.mean(axis=1)
+        cos = np.sum(front * to_cam, 1) / np.linalg.norm(to_cam, axis=1)
+        return fixed(self.camera.project(world)), (cos > 0.15).tolist()
+
     def _shadow_polygons(self) -> np.ndarray:
         H = self.pose.body.height
         ang = np.linspace(0, 2 * np.pi, 20, endpoint=False)
@@ -325,6 +341,8 @@ class Mannequin:
         for (sc, sh, _), colour in zip(_HULL_LAYERS, self._hull_colour[which]):
             poly = c + (hull - c) * sc + sh * 0.5 * size * LIGHT
             cv2.fillConvexPoly(img, np.rint(poly * _ONE).astype(np.int32), colour, cv2.LINE_AA, SHIFT)
+        if which == 0 and self._collar_seen[i]:
+            cv2.fillConvexPoly(img, self._collar[i], self._collar_colour, cv2.LINE_AA, SHIFT)
 
     def _ellipse(self, img, key: str, scale: float, i: int, colour) -> None:
         centre, half, angle = self._head[(key, scale)][0][i], self._head[(key, scale)][1][i], self._head[(key, scale)][2][i]

@@ -43,6 +43,7 @@ __all__ = [
 EXTRA_POINTS: dict[str, tuple[str, tuple[float, float, float]]] = {
     "head_centre": ("neck", (0.0, 0.005, 0.925)),
     "chin": ("neck", (0.0, 0.012, 0.865)),
+    "neck_base": ("chest", (0.0, 0.0, 0.834)),  # above the neck joint: the neck ends inside the collar
     "nose_root": ("neck", (0.0, 0.054, 0.929)),
     "right_heel_top": ("right_ankle", (0.055, -0.022, 0.022)),
     "left_heel_top": ("left_ankle", (-0.055, -0.022, 0.022)),
@@ -58,7 +59,7 @@ HEAD_RADII = (0.046, 0.058, 0.070)
 #: The body volume: (name, end a, end b, radius at a, radius at b); ends are
 #: joints, landmarks or :data:`EXTRA_POINTS`; radii are fractions of body height.
 CAPSULES: tuple[tuple[str, str, str, float, float], ...] = (
-    ("neck", "neck", "chin", 0.030, 0.028),
+    ("neck", "neck_base", "chin", 0.030, 0.028),
     ("head", "head_centre", "head_centre", 0.064, 0.064),
     ("shoulders", "right_shoulder", "left_shoulder", 0.048, 0.048),
     ("chest", "chest", "neck", 0.088, 0.070),

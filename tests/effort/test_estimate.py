@@ -30,7 +30,7 @@ def angry():
 
 
 def test_movements_pooled_and_emotion(angry):
-    score, _, res = angry
+    _score, _, res = angry
     assert len(res.movements) == 3  # the support symbol bears no Effort
     assert all(m.posterior.converged for m in res.movements)
     b = res.pooled.posterior.summary(0)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
+
 from capture2notation.body import JOINTS, Body, joint_index
 from capture2notation.fitting import Camera, PoseModel
 from capture2notation.fitting.fit import TARGETS_2D
@@ -66,11 +68,8 @@ def limb_direction_errors(joints, truth) -> np.ndarray:
     return np.concatenate(out)
 
 
-# The test modules are imported with --import-mode=importlib, so helpers reach
-# them as fixtures rather than imports.
-import pytest  # noqa: E402
-
-
+# The test modules are imported with --import-mode=importlib, so the helpers
+# reach them as a fixture rather than an import.
 @pytest.fixture(scope="session")
 def synth():
     """The helpers above: ``synth.make_motion``, ``synth.observe``, ``synth.limb_direction_errors``."""

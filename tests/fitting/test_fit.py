@@ -152,3 +152,30 @@ def test_long_clips_are_solved_in_chunks_without_seams(monkeypatch, synth):
     step = np.linalg.norm(np.diff(chunked.joints, axis=0), axis=-1).max(axis=1)
     true_step = np.linalg.norm(np.diff(truth, axis=0), axis=-1).max(axis=1)
     assert np.all(step < true_step + 0.03)
+
+
+@pytest.mark.parametrize("hfov", [45.0, 75.0])
+def test_focal_length_is_refined_towards_the_true_one(hfov, synth):
+    from capture2notation.fitting import refine_focal
+
+    body = Body()
+    ang, root = synth.make_motion(30, seed=2, body=body)
+    cam = Camera.default((640, 480), hfov_deg=hfov, distance=3.0)
+    xy, conf, world, _ = synth.observe(ang, root, cam, body, noise_px=1.0)
+    got = refine_focal(xy, conf, 25.0, Camera.default((640, 480)), world=world)
+    got_hfov = np.degrees(2 * np.arctan(320.0 / got.focal))
+    assert abs(got_hfov - hfov) < 8.0
+    # Without world landmarks focal length and distance trade off: the default stays.
+    assert refine_focal(xy, conf, 25.0, Camera.default((640, 480))).focal == Camera.default((640, 480)).focal
+
+
+def test_2d_landmarks_alone_are_lifted_to_a_plausible_pose(scene, synth):
+    # The marker backend has no world landmarks: depth comes from the image
+    # lengths of the segments and the front/back choice from the lifting rule.
+    body, ang, root, cam = scene
+    xy, conf, _, truth = synth.observe(ang, root, cam, body)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam)
+    assert np.median(synth.limb_direction_errors(res.joints, truth)) < 6.0
+    # Reprojection is faithful whatever the depth: the fit explains the image.
+    proj = cam.project(res.joints[:, joint_index("right_wrist")])
+    assert np.median(np.linalg.norm(proj - xy[:, 16], axis=1)) < 2.0

@@ -76,3 +76,28 @@ def test_models_path_without_cache_says_what_to_run(tmp_path, monkeypatch):
 def test_models_verify(pose_model_path):
     result = CliRunner().invoke(main, ["models", "verify", "--model", str(pose_model_path)])
     assert result.exit_code == 0 and "ok (sha256" in result.output
+
+
+def test_markers_from_a_json_file(tmp_path):
+    """Real footage: gloves of configurable colours, given as HSV ranges or BGR colours."""
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for i in range(2):
+        img = np.full((60, 80, 3), 128, np.uint8)
+        cv2.circle(img, (20, 20 + 10 * i), 5, (0, 0, 220), -1)  # red glove: right wrist
+        cv2.circle(img, (60, 30), 5, (220, 0, 0), -1)  # blue glove: left wrist
+        cv2.imwrite(str(folder / f"{i}.png"), img)
+    spec = tmp_path / "gloves.json"
+    spec.write_text(
+        '[{"landmark": "right_wrist", "bgr": [0, 0, 220]},'
+        ' {"landmark": 15, "hsv_low": [110, 80, 60], "hsv_high": [130, 255, 255]}]'
+    )
+    out = tmp_path / "g.npz"
+    result = CliRunner().invoke(main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--markers", str(spec)])
+    assert result.exit_code == 0, result.output
+    track = KeypointTrack.load(out)
+    np.testing.assert_allclose(track.xy[:, 16, :2], [[20, 20], [20, 30]], atol=0.5)
+    np.testing.assert_allclose(track.xy[:, 15, :2], [[60, 30], [60, 30]], atol=0.5)
+    spec.write_text('[{"landmark": "left_wirst", "bgr": [0, 0, 220]}]')
+    bad = CliRunner().invoke(main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--markers", str(spec)])
+    assert bad.exit_code == 2 and "marker entry 0" in bad.output and "left_wirst" in bad.output

@@ -111,3 +111,23 @@ def test_bad_inputs_are_named(tmp_path):
         input_kind(tmp_path / "empty")
     with pytest.raises(PipelineError, match="--tempo"):
         capture(tmp_path / "x.bvh", tmp_path / "o", tempo=-1, progress=False)
+
+
+def test_rendered_video_through_markers_backend(tmp_path):
+    """The video path: render (colour markers) → keypoints → fit → notation files and overlay."""
+    render = pytest.importorskip("synthetic.render")
+    from capture2notation.notation.formats import loads
+
+    score = loads("tempo: 90\n0 1 right_arm right middle\n1 1 right_arm place low\n", "lab")
+    render.render_score(score, tmp_path / "r", fps=25, size=(320, 240), view="front", style="markers", progress=False)
+    res = capture(tmp_path / "r" / "video.mp4", tmp_path / "c", backend="markers", tempo=90, progress=False,
+                  effort=False)
+    assert res.kind == "video" and res.track is not None
+    assert (tmp_path / "c" / "overlay.mp4").stat().st_size > 0
+    with np.load(tmp_path / "c" / "capture.npz") as z:
+        assert z["keypoints"].shape == (res.n_frames, 33, 3)
+        assert np.isfinite(z["keypoints"][:, 16, :2]).all(axis=1).mean() > 0.9  # right wrist marker seen (no depth from markers)
+    # The sidecar's camera was used for the fit; the arm's raise is found at the right time.
+    arm = [s for s in res.score.symbols if s.part == "right_arm"]
+    assert arm and arm[0].start == 0 and arm[0].level == "middle"
+    assert 'src="overlay.mp4"' in (tmp_path / "c" / "index.html").read_text()

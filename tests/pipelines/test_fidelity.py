@@ -1,6 +1,5 @@
 """The fidelity study: configuration, grid, one job, determinism, resuming, Dask."""
 
-from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -11,7 +10,6 @@ from pipelines.fidelity.conditions import (
     Job,
     Performance,
     build_conditions,
-    build_jobs,
     phrase_complexity,
     take_variation,
 )
@@ -119,7 +117,8 @@ def test_same_seed_same_results_and_resume(tmp_path):
     cfg = StudyConfig(**TINY)
     a = run_study(cfg, tmp_path / "a", workers=1, progress=False)
     text = (tmp_path / "a" / "results.csv").read_text()
-    assert a.summary["jobs"] == {"total": 12, "ran": 12, "cached": 0, "failed": 0}
+    jobs = {k: v for k, v in a.summary["jobs"].items() if k != "job_seconds"}
+    assert jobs == {"total": 12, "ran": 12, "cached": 0, "failed": 0}
     assert len(text.strip().splitlines()) == 13
     again = run_study(cfg, tmp_path / "a", workers=1, progress=False)
     assert again.summary["jobs"]["ran"] == 0 and again.summary["jobs"]["cached"] == 12
@@ -127,21 +126,23 @@ def test_same_seed_same_results_and_resume(tmp_path):
     b = run_study(cfg, tmp_path / "b", workers=2, progress=False)
     assert (tmp_path / "b" / "results.csv").read_text() == text
     assert b.summary["experiment1"][0]["n"] == 2 * 3 + 1 * 2  # 2 same pairs x3, 1 different pair x2
-    c = run_study(StudyConfig(**{**TINY, "seed": 1}), tmp_path / "c", workers=1, progress=False)
-    assert (tmp_path / "c" / "results.csv").read_text() != text
+    # Another seed gives other takes and other jitter.
+    job = Job(build_conditions(cfg)[0], Performance("figure7", "medium", "sad", 0, "test"))
+    r0, r1 = run_condition(job, 0, "truth", bootstrap=0), run_condition(job, 1, "truth", bootstrap=0)
+    assert r0["tempo_true"] != r1["tempo_true"] and r0["mpjpe_mm"] != r1["mpjpe_mm"]
 
 
 def test_dask_cluster_gives_the_same_results(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
-    cfg = StudyConfig(**{**TINY, "emotions": ("happy", "angry")})
-    local = run_study(cfg, tmp_path / "local", workers=1, progress=False)
+    cfg = StudyConfig(**{**TINY, "emotions": ("happy", "angry"), "frame_rates": (25,)})
+    run_study(cfg, tmp_path / "local", workers=1, progress=False)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
         dask = run_study(cfg, tmp_path / "dask", scheduler=cl.scheduler_address, progress=False)
-    assert dask.summary["jobs"]["ran"] == 12
+    assert dask.summary["jobs"]["ran"] == 8
     assert (tmp_path / "dask" / "results.csv").read_text() == (tmp_path / "local" / "results.csv").read_text()
 
 
 def test_unreachable_scheduler_is_a_one_line_error(tmp_path):
     cfg = StudyConfig(**TINY)
     with pytest.raises(PipelineError, match="Dask scheduler"):
-        run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False)
+        run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False, connect_timeout=2)

@@ -74,8 +74,8 @@ def test_score_report_in_chromium(tmp_path):
 
 def test_fidelity_report_in_chromium(tmp_path):
     cfg = StudyConfig(
-        phrases=("figure7", "port_de_bras"), emotions=("happy", "sad", "angry"), takes=2, training_takes=2,
-        capture="truth", frame_rates=(25, 5), image_sizes=((220, 175), (640, 480)), views=("front",),
+        phrases=("figure7",), emotions=("happy", "sad"), takes=2, training_takes=2,
+        capture="truth", frame_rates=(25, 5), resampling=("naive",), image_sizes=((220, 175), (640, 480)), views=("front",),
         compression=(0,), noise=(0.0,), bootstrap=3,
     )
     run_fidelity_study(cfg, tmp_path / "study", workers=1, progress=False)

@@ -8,7 +8,6 @@ import pytest
 from click.testing import CliRunner
 
 from capture2notation.errors import PipelineError
-from capture2notation.io.atomic import write_text
 
 pytest.importorskip("synthetic.interpret", reason="the virtual dancer dances score files")
 from capture2notation.notation import formats  # noqa: E402
@@ -95,3 +94,14 @@ def test_cli_score(lab, tmp_path):
     r = CliRunner().invoke(main, ["score", str(lab), str(lab), "-o", str(tmp_path / "o")])
     assert r.exit_code == 0, r.output
     assert "symbol agreement 100%" in r.output
+
+
+def test_truth_sidecar_against_its_score(lab, tmp_path):
+    job = pytest.importorskip("synthetic.render.job", reason="the renderer writes truth sidecars")
+    out = job.render_score(formats.read(lab), tmp_path / "render", size=(96, 72), style="stick", progress=False)
+    truth = load_side(out / "truth.npz")
+    assert truth.kind == "truth" and truth.score is not None
+    res = compare_sides(truth, load_side(lab))
+    gest = [m for m in res["movements"] if m.verdict != "n/a"]
+    assert all(m.verdict == "match" for m in gest)
+    assert np.nanmax(res["pa_mpjpe_mm"]) < 1.0

@@ -11,7 +11,8 @@ from capture2notation.body import Body
 from capture2notation.errors import QuantiseError
 from capture2notation.notation.model import Score, Symbol
 from capture2notation.quantise.agreement import compare_scores, score_differences
-from capture2notation.quantise.segment import SegmentParams, movement_spans, segment, segment_motion
+from capture2notation.quantise.segment import SegmentParams, segment, segment_motion
+from capture2notation.quantise.spans import movement_spans
 
 from quantise_motions import arm_angles, build_motion
 
@@ -114,7 +115,22 @@ def test_movement_spans_hysteresis_and_split():
     s[20:31] = [2, 40, 80, 40, 5, 0.5, 5, 40, 80, 40, 2]  # two back to back
     s[35] = 15  # a blip below the peak threshold
     spans = movement_spans(s, low=3.0, high=20.0, split_ratio=0.35)
-    assert spans == [(5, 9), (20, 25), (26, 30)]
+    # Split at the 0.5 minimum; each movement keeps where it exceeds 10 % of its peak.
+    assert spans == [(6, 8), (21, 23), (27, 29)]
+
+
+def test_movement_spans_on_clean_motion_cut_at_written_poses():
+    s = np.zeros(20)
+    s[2:12] = [1e-3, 5, 20, 30, 20, 6, 0.5, 25, 30, 10]
+    calls = []
+
+    def key(f, since):
+        calls.append(f)
+        return f == 8  # the pose after interval 7 is written
+
+    key.on_grid = True
+    assert movement_spans(s, low=1e-4, high=2e-4, split_ratio=0.35, key_pose=key) == [(2, 7), (8, 11)]
+    assert 8 in calls
 
 
 def test_too_short_or_bad_input():

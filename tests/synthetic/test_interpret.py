@@ -12,7 +12,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from capture2notation.body import JOINTS, Body, euler_to_matrix, global_rotations, joint_index, segment_vectors
+from capture2notation.body import Body, global_rotations, joint_index, segment_vectors
 from capture2notation.effort.model import progress
 from capture2notation.errors import SyntheticError
 from capture2notation.notation import PART_MIDDLE_JOINT, PART_SEGMENTS, Effort, Score, Symbol, classify

@@ -296,3 +296,12 @@ def test_visibility_of_a_long_take_equals_frame_by_frame():
     single = np.concatenate([point_visibility(cam, pose.landmarks[i:i + 1], a[i:i + 1], b[i:i + 1], r) for i in range(n)])
     np.testing.assert_array_equal(whole, single)
     assert 0.3 < whole.mean() < 0.95  # random poses hide some points, not all
+
+
+def test_mannequin_shirt_has_a_v_neck_only_at_the_front():
+    cam = Camera.for_view("front", (640, 480), BODY.height)
+    front, back = _pose(), _pose(pelvis=(0.0, 0.0, np.pi))
+    # A point inside the V, on the chest's front; the same pixel seen from behind is the shirt's back.
+    u, v = np.round(cam.project(np.array([0.0, 0.05, 0.79]) * BODY.height)).astype(int)
+    green = [int(make_renderer(p, cam, "mannequin").frame(0)[v, u, 1]) for p in (front, back)]
+    assert green[0] > 110 and green[1] < 100  # skin (G ≈ 144) in front, red shirt (G ≈ 64) behind

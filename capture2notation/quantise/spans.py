@@ -1,0 +1,131 @@
+"""Movements in a speed signal: hysteresis runs, split at speed minima or written poses.
+
+Used by :mod:`.segment` (gestures) and :mod:`.supports` (the supporting
+system).  Interval ``i`` of a speed signal spans frames ``i → i + 1``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["movement_spans"]
+
+#: Speeds below this (degrees per second) are rounding noise of a hold, not
+#: movement; a sudden Effort's first frame still moves far more.
+_ZERO_SPEED = 1e-6
+
+
+def movement_spans(
+    speed: np.ndarray, low: float, high: float, split_ratio: float, key_pose=None
+) -> list[tuple[int, int]]:
+    """Movements in a per-interval speed signal.
+
+    Parameters
+    ----------
+    speed : (N,) ndarray
+        Speed over each frame interval (interval i spans frames i → i+1);
+        NaN counts as still.
+    low, high : float
+        Hysteresis thresholds: a run above `low` is a movement if it peaks
+        above `high`.
+    split_ratio : float
+        See :class:`~.segment.SegmentParams`.
+    key_pose : callable, optional
+        ``key_pose(frame, since) -> bool`` with attribute ``on_grid`` (see
+        :func:`~.segment._key_pose_fn`).  When given (clean motion), a run is split at
+        the local speed minima it accepts, however shallow, and never
+        elsewhere — a limb passing near its turning axis slows down
+        mid-movement without arriving anywhere.
+
+    Returns
+    -------
+    list of (a, b)
+        Interval index ranges, inclusive: the movement leaves the pose of
+        frame ``a`` and arrives at the pose of frame ``b + 1``.
+    """
+    s = np.nan_to_num(np.asarray(speed, dtype=float), nan=0.0)
+    n = s.size
+    above = s > low
+    spans: list[tuple[int, int]] = []
+    if not above.any():
+        return spans
+    edges = np.flatnonzero(np.diff(np.r_[0, above.astype(int), 0]))
+    runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+    taken = np.zeros(n, bool)
+    for a, b in runs:
+        if s[a : b + 1].max() <= high:
+            continue
+        # Widen down the speed slope to the bracketing minima; a frame interval
+        # with no motion at all (a hold) stops the walk.
+        while a > 0 and not taken[a - 1] and _ZERO_SPEED < s[a - 1] <= s[a] and not above[a - 1]:
+            a -= 1
+        while b < n - 1 and _ZERO_SPEED < s[b + 1] <= s[b] and not above[b + 1]:
+            b += 1
+        taken[a : b + 1] = True
+        if key_pose is None:
+            for lo, hi in _split(s, a, b, split_ratio, high):
+                # Noisy motion: the walk down may run far into smoothed jitter,
+                # so each movement keeps only where it exceeds a tenth of its peak.
+                idx = np.flatnonzero(s[lo : hi + 1] >= 0.1 * s[lo : hi + 1].max())
+                spans.append((lo + int(idx[0]), lo + int(idx[-1])))
+        else:
+            spans.extend(_split_at_key_poses(s, a, b, low, key_pose))
+    return spans
+
+
+def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> list[tuple[int, int]]:
+    """Split [a, b] where the motion passes a written pose.
+
+    With a beat grid every grid frame accepted by ``key_pose`` is a boundary;
+    without, only such frames next to a local speed minimum (a minimum in
+    interval m puts the boundary at frame m, the next movement's first
+    interval, or m + 1, this movement's last).
+    """
+    cuts = []
+    if key_pose.on_grid:
+        for f in range(a + 1, b + 1):
+            if key_pose(f, cuts[-1] if cuts else a):
+                cuts.append(f)
+    else:
+        for m in range(a + 1, b):
+            if not (s[m] <= s[m - 1] and s[m] <= s[m + 1]):
+                continue
+            for f in (m, m + 1):
+                if a < f <= b and (not cuts or f > cuts[-1]) and key_pose(f, cuts[-1] if cuts else a):
+                    cuts.append(f)
+                    break
+    bounds = [a] + cuts + [b + 1]
+    out = []
+    start = None
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        start = lo if start is None else start
+        # A slow-starting movement (a sudden Effort) stays on its start pose
+        # for a few frames: those pieces belong to the movement that follows.
+        if s[lo:hi].max() > low:
+            out.append((start, hi - 1))
+            start = None
+    if start is not None and out:
+        out[-1] = (out[-1][0], b)
+    return out
+
+
+def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float) -> list[tuple[int, int]]:
+    """Split interval range [a, b] at its deepest qualifying interior minimum, recursively."""
+    if b - a < 2:
+        return [(a, b)]
+    seg = s[a : b + 1]
+    i = np.arange(1, seg.size - 1)
+    is_min = (seg[i] <= seg[i - 1]) & (seg[i] <= seg[i + 1])
+    best, best_depth = None, None
+    for k in i[is_min]:
+        left, right = seg[:k].max(), seg[k + 1 :].max()
+        if min(left, right) <= high:
+            continue
+        depth = seg[k] / min(left, right)
+        if depth < ratio and (best_depth is None or depth < best_depth):
+            best, best_depth = k, depth
+    if best is None:
+        return [(a, b)]
+    m = a + int(best)
+    # The minimum interval holds the boundary: it closes the first movement.
+    return _split(s, a, m, ratio, high) + _split(s, m + 1, b, ratio, high)
