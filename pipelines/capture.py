@@ -314,6 +314,38 @@ def _write_effort(outdir: Path, score: Score, motion, seed: int) -> dict:
     return {Path(p).name: Path(p) for p in paths.values()}
 
 
+def _interval(d: dict) -> str:
+    lo, hi = d["ci90"]
+    return f"{d['median']:.2f} [{lo:.2f}, {hi:.2f}]"
+
+
+def _effort_html(files: dict) -> str:
+    """The Effort section of the index page: pooled estimate, emotion, plots."""
+    if "effort.json" not in files:
+        return ""
+    data = json.loads(Path(files["effort.json"]).read_text(encoding="utf-8"))
+    pooled = data.get("pooled") or {}
+    rows = "".join(
+        f"<tr><td>{name}</td><td>{_interval(pooled[key])}</td></tr>"
+        for key, name in (("time", "Time b"), ("weight", "Weight x0"), ("space", "Space S"))
+        if key in pooled
+    )
+    emotion = data.get("emotion") or {}
+    feelings = " · ".join(f"{html.escape(k)} {v:.0%}" for k, v in sorted(emotion.items(), key=lambda kv: -kv[1]))
+    converged = "all converged" if all(m.get("converged") for m in data.get("movements", [])) else (
+        "some posteriors did not converge (see effort.json)")
+    plots = "".join(
+        f'<img src="{name}" alt="{alt}" style="max-width: 48%">'
+        for name, alt in (("effort_progress.png", "progress curves with posterior bands"),
+                          ("effort_pooled.png", "pooled Effort posterior"))
+        if name in files
+    )
+    return f"""<h2>Laban Effort (median and 90 % interval)</h2>
+<p>{pooled.get("n_movements", 0)} movements pooled, {converged}. Emotion: {feelings or "not estimated"}.</p>
+<table><tr><th>factor</th><th>estimate</th></tr>{rows}</table>
+<div>{plots}</div>"""
+
+
 def index_html(result: CaptureResult) -> str:
     """A self-contained page: the staff beside the overlay video, the symbols and the files."""
     score = result.score
@@ -331,6 +363,7 @@ def index_html(result: CaptureResult) -> str:
     tempo = f"{score.tempo} bpm" + (" (estimated)" if result.segmentation.tempo_estimated else "")
     skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
+    effort = _effort_html(result.files)
     return f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>Capture: {html.escape(score.title)}</title>
 <style>
@@ -350,6 +383,7 @@ tempo {html.escape(tempo)} · meter {score.meter} · {len(score.symbols)} symbol
 <table><tr><th>start</th><th>duration</th><th>part</th><th>direction</th><th>level</th><th>bend</th></tr>
 {rows}
 </table></div></div>
+{effort}
 <h2>Files</h2><p>{links}</p>
 {"<h2>Not written</h2><ul>" + skipped + "</ul>" if skipped else ""}
 <p>Time: {html.escape(timing)}</p>

@@ -228,10 +228,16 @@ def iter_frames(path, *, fps: float | None = None, start: int = 0, stop: int | N
 class VideoWriter:
     """Write BGR frames to a video file atomically (the file appears on close).
 
+    ``.mp4`` is written as H.264 (yuv420p, ``+faststart``) through the ffmpeg
+    that `imageio-ffmpeg` ships, because that is what web browsers play (the
+    capture's ``index.html`` embeds the overlay); OpenCV's own ``mp4v`` is the
+    fallback for odd frame sizes, which yuv420p cannot hold.  ``.avi`` uses
+    ``MJPG``.
+
     Parameters
     ----------
     path : str or Path
-        Output file; ``.mp4`` uses the ``mp4v`` codec, ``.avi`` ``MJPG``.
+        Output file (``.mp4``, ``.m4v``, ``.mov`` or ``.avi``).
     fps : float
         Frame rate.
     size : (int, int)
@@ -252,6 +258,7 @@ class VideoWriter:
         self.frames_written = 0
         self._ctx = None
         self._writer = None
+        self._ffmpeg = None
 
     def __enter__(self) -> VideoWriter:
         suffix = self.path.suffix.lower()
@@ -259,6 +266,9 @@ class VideoWriter:
             raise VideoError(f"{self.path}: cannot write video with extension {suffix!r}; expected one of {sorted(self._FOURCC)}")
         self._ctx = atomic_path(self.path)
         tmp = self._ctx.__enter__()
+        if suffix != ".avi" and self.size[0] % 2 == 0 and self.size[1] % 2 == 0:
+            self._ffmpeg = _h264_writer(tmp, self.fps, self.size)
+            return self
         self._writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*self._FOURCC[suffix]), self.fps, self.size)
         if not self._writer.isOpened():
             self._ctx.__exit__(VideoError, None, None)
@@ -272,9 +282,31 @@ class VideoWriter:
                 f"{self.path}: frame {self.frames_written} has size {image.shape[1]}x{image.shape[0]}, "
                 f"expected {self.size[0]}x{self.size[1]}"
             )
-        self._writer.write(np.ascontiguousarray(image, dtype=np.uint8))
+        frame = np.ascontiguousarray(image, dtype=np.uint8)
+        if self._ffmpeg is not None:
+            self._ffmpeg.send(frame)
+        else:
+            self._writer.write(frame)
         self.frames_written += 1
 
     def __exit__(self, exc_type, exc, tb):
-        self._writer.release()
+        if self._ffmpeg is not None:
+            self._ffmpeg.close()
+        else:
+            self._writer.release()
         return self._ctx.__exit__(exc_type, exc, tb)
+
+
+def _h264_writer(path: Path, fps: float, size: tuple[int, int]):
+    """A started imageio-ffmpeg generator encoding BGR frames to H.264 at `path`."""
+    import imageio_ffmpeg
+
+    gen = imageio_ffmpeg.write_frames(
+        str(path), size, fps=fps, codec="libx264", pix_fmt_in="bgr24", pix_fmt_out="yuv420p",
+        macro_block_size=1, ffmpeg_log_level="error",
+        # veryfast keeps encoding well above the capture's frame rate; faststart
+        # moves the index to the front so a browser can play while loading.
+        output_params=["-preset", "veryfast", "-movflags", "+faststart"],
+    )
+    gen.send(None)
+    return gen

@@ -37,3 +37,12 @@ def test_temp_file_keeps_suffix_for_writers_that_need_it(tmp_path):
         assert tmp.suffix == ".mp4"
         assert tmp.parent == tmp_path
         tmp.write_bytes(b"x")
+
+
+def test_written_files_get_the_umask_mode_not_mkstemps_0600(tmp_path):
+    import os
+
+    mask = os.umask(0o022)
+    os.umask(mask)
+    p = write_text(tmp_path / "out.txt", "x")
+    assert p.stat().st_mode & 0o777 == 0o666 & ~mask

@@ -1,4 +1,4 @@
-"""``c2n render`` and ``c2n demo`` from the command line (small images, few frames)."""
+"""``c2n render`` from the command line (small images, few frames)."""
 
 from __future__ import annotations
 
@@ -113,32 +113,3 @@ def test_missing_or_malformed_score_names_the_file(tmp_path):
         res = CliRunner().invoke(main, ["render", str(path), "-o", str(tmp_path / "o")])
         assert res.exit_code == 2
         assert res.output.count("\n") == 1 and path.name in res.output
-
-
-def test_demo_renders_the_builtin_phrases(tmp_path):
-    from pipelines.commands.demo import DEMO_PHRASES, run_demo
-
-    outs = run_demo(tmp_path / "demo", fps=4, size=(64, 48), style="stick", progress=False)
-    assert list(outs) == list(DEMO_PHRASES)
-    for name, folder in outs.items():
-        truth = read_truth(folder / "truth.npz")
-        n, _ = _frames(folder / "video.mp4")
-        assert n == truth.n_frames > 1, name
-        assert (folder / "score.lab").exists()
-
-
-def test_demo_command_prints_where_outputs_are(tmp_path, monkeypatch):
-    import pipelines.commands.demo as demo_mod
-
-    calls = {}
-
-    def fake_run(outdir, **kw):  # the rendering itself is tested above; here only the command's wiring
-        calls.update(kw, outdir=outdir)
-        return {p: tmp_path / p for p in demo_mod.DEMO_PHRASES}
-
-    monkeypatch.setattr(demo_mod, "run_demo", fake_run)
-    res = CliRunner().invoke(main, ["demo", "-o", str(tmp_path), "--size", "80x60"])
-    assert res.exit_code == 0, res.output
-    assert calls["size"] == (80, 60) and calls["outdir"] == str(tmp_path)
-    for p in demo_mod.DEMO_PHRASES:
-        assert str(tmp_path / p / "video.mp4") in res.output
