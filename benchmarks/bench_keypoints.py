@@ -8,7 +8,14 @@ Prints
   mp4 at 640×480 and 1280×720, with the share of each step;
 * the landmark model alone (ms per call, 1 session, ``threads`` intra-op);
 * accuracy on MediaPipe's fixtures (``pose.jpg``, ``pose_squats.mp4``) when
-  ``../shared/fixtures`` is present: the error distribution per coordinate.
+  ``../shared/fixtures`` is present: the error distribution per coordinate;
+* on mannequin renders of the built-in phrases (front, 45°, side): PCK at
+  5 % of the person's height per joint, left/right swaps and the mean
+  signed error (x, y) in pixels, with one pass per frame and with the flip
+  test (``flip_test``: the mirrored crop read too and averaged).
+
+Speed and the fixtures are measured with one pass per frame (the default)
+and, at 640×480, with the flip test.
 """
 
 from __future__ import annotations
@@ -64,7 +71,8 @@ def _render(path: Path, size, n_frames: int) -> None:
 
 def bench_end_to_end(bp: BlazePose, size, n_frames: int, tmp: Path) -> None:
     video = tmp / f"bench_{size[0]}x{size[1]}.mp4"
-    _render(video, size, n_frames)
+    if not video.exists():
+        _render(video, size, n_frames)
     t0 = time.perf_counter()
     n_decoded = sum(1 for _ in iter_frames(video))
     t_decode = time.perf_counter() - t0
@@ -77,10 +85,10 @@ def bench_end_to_end(bp: BlazePose, size, n_frames: int, tmp: Path) -> None:
         crop_to_tensor(f, np.array([size[0] / 2, size[1] / 2, size[1], size[1], 0.2]))
     t_crop = (time.perf_counter() - t0) / len(frames)
     print(
-        f"end-to-end {size[0]}x{size[1]}: {len(track) / t_all:6.1f} fps "
+        f"end-to-end {size[0]}x{size[1]}{' (flip test)' if bp.flip_test else ''}: {len(track) / t_all:6.1f} fps "
         f"({1000 * t_all / len(track):.1f} ms/frame wall, {1000 * c_all / len(track):.1f} ms/frame CPU, {len(track)} frames; "
         f"decode {1000 * t_decode / n_decoded:.1f} ms, crop+convert {1000 * t_crop:.2f} ms, "
-        f"person found in {np.mean(track.presence > 0):.0%})"
+        f"person found in {np.mean(track.presence > 0):.0%}; load average {os.getloadavg()[0]:.1f})"
     )
 
 
@@ -127,7 +135,7 @@ def bench_fixtures(bp: BlazePose) -> None:
 
 
 def bench_mannequin(bp: BlazePose, fps: float) -> None:
-    """PCK@5 % of person height per joint and left/right swaps on the built-in phrases."""
+    """PCK@5 % of person height per joint, left/right swaps and bias on the built-in phrases."""
     from capture2notation.body import Body
     from capture2notation.keypoints.evaluate import PAIRS, left_right_swaps, pck, person_height_px
     from synthetic import render
@@ -137,6 +145,7 @@ def bench_mannequin(bp: BlazePose, fps: float) -> None:
     joints = [i for pair in PAIRS.values() for i in pair]
     for view in ("front", "45", "side"):
         hits, counts, swaps, n = {}, {}, dict.fromkeys(PAIRS, 0), 0
+        signed = {j: [] for j in joints}
         for name, score in sorted(builtin_phrases().items()):
             pose = render.Pose.from_motion(interpret(score, fps, Body()))
             cam = render.Camera.for_view(view, (640, 480), pose.body.height)
@@ -144,6 +153,9 @@ def bench_mannequin(bp: BlazePose, fps: float) -> None:
             track = extract_frames(render.render_frames(pose, cam, "mannequin"), pose.fps, estimator=bp)
             radius = 0.05 * person_height_px(cam.K, cam.R, cam.t, pose.root, pose.body.height)
             vis = truth["visibility"] > 0
+            d = track.xy[:, :, :2] - truth["keypoints"]
+            for j in joints:
+                signed[j].append(d[vis[:, j], j])
             for j, v in pck(track.xy, truth["keypoints"], radius, vis, joints).items():
                 if np.isfinite(v):
                     hits[j] = hits.get(j, 0.0) + v * vis[:, j].sum()
@@ -155,7 +167,10 @@ def bench_mannequin(bp: BlazePose, fps: float) -> None:
             n += len(track)
         names = {i: f"{p}_{s}" for p, (left, right) in PAIRS.items() for s, i in (("L", left), ("R", right))}
         row = " ".join(f"{names[j]}={hits[j] / counts[j]:.3f}" for j in joints if counts.get(j))
-        print(f"mannequin {view} ({n} frames at {fps:g} fps, visible joints): PCK@5% {row}; swaps {swaps}")
+        mode = "flip test" if bp.flip_test else "one pass"
+        print(f"mannequin {view}, {mode} ({n} frames at {fps:g} fps, visible joints): PCK@5% {row}; swaps {swaps}")
+        bias = {j: np.nanmean(np.concatenate(signed[j]), axis=0) for j in joints if counts.get(j)}
+        print("  mean signed error (x, y) px: " + " ".join(f"{names[j]}=({b[0]:+.1f},{b[1]:+.1f})" for j, b in bias.items()))
 
 
 def main() -> None:
@@ -170,9 +185,14 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="c2n-bench-") as tmp:
         for size in ((640, 480), (1280, 720)):
             bench_end_to_end(bp, size, args.frames, Path(tmp))
+        bp.flip_test = True
+        bench_end_to_end(bp, (640, 480), args.frames, Path(tmp))
+        bp.flip_test = False
     bench_fixtures(bp)
     if args.mannequin_fps > 0:
-        bench_mannequin(bp, args.mannequin_fps)
+        for flip in (False, True):
+            bp.flip_test = flip
+            bench_mannequin(bp, args.mannequin_fps)
 
 
 if __name__ == "__main__":

@@ -126,7 +126,8 @@ def _with_fps(motion, fps: float):
     return motion.replace(fps=float(fps), times=np.arange(T) / float(fps))
 
 
-def load_motion(path, kind: str, backend: str = "blazepose", fps_override=None, progress: bool = True):
+def load_motion(path, kind: str, backend: str = "blazepose", fps_override=None, progress: bool = True,
+                flip_test: bool = False):
     """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
 
     Returns
@@ -142,7 +143,7 @@ def load_motion(path, kind: str, backend: str = "blazepose", fps_override=None, 
         from capture2notation.keypoints import extract
 
         t0 = time.perf_counter()
-        track = extract(path, backend=backend, fps=fps_override, progress=progress)
+        track = extract(path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test)
         seconds["keypoints"] = time.perf_counter() - t0
         camera = None
         sidecar = Path(path).parent / "truth.npz" if Path(path).is_file() else Path(path) / "truth.npz"
@@ -187,6 +188,7 @@ def capture(
     effort: bool = True,
     seed: int = 0,
     overlay: bool = True,
+    flip_test: bool = False,
 ) -> CaptureResult:
     """Capture notation from a video or motion file.
 
@@ -214,6 +216,9 @@ def capture(
         Seed of the Effort posteriors.
     overlay : bool
         Write ``overlay.mp4`` for video input.
+    flip_test : bool
+        BlazePose also reads a mirrored copy of each crop (see
+        :class:`capture2notation.keypoints.BlazePose`): more accurate, slower.
 
     Returns
     -------
@@ -223,7 +228,7 @@ def capture(
     kind = input_kind(input_path)
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress)
+    motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress, flip_test)
     joints = np.asarray(motion.joints, dtype=float)
     fps = float(motion.fps)
     if not np.isfinite(joints).any():

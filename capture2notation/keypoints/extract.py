@@ -20,11 +20,11 @@ __all__ = ["BACKENDS", "extract", "extract_frames"]
 BACKENDS = ("blazepose", "markers")
 
 
-def _make_backend(backend: str, model, threads: int, smooth: bool, markers):
+def _make_backend(backend: str, model, threads: int, smooth: bool, markers, flip_test: bool = False):
     if backend == "blazepose":
         from .blazepose import BlazePose
 
-        return BlazePose(model, threads=threads, smooth=smooth)
+        return BlazePose(model, threads=threads, smooth=smooth, flip_test=flip_test)
     if backend == "markers":
         from .markers import MarkerTracker
 
@@ -43,6 +43,7 @@ def extract_frames(
     markers=None,
     estimator=None,
     progress=None,
+    flip_test: bool | None = None,
 ) -> KeypointTrack:
     """Keypoints of a stream of frames.
 
@@ -67,6 +68,10 @@ def extract_frames(
         its ``smooth`` flag set from `smooth`.
     progress : callable, optional
         Called with each processed frame index (e.g. a tqdm ``update``).
+    flip_test : bool, optional
+        BlazePose only: also read the mirrored crop and average (more
+        accurate, twice the inference cost).  Default: off for a new
+        estimator, unchanged for a given one.
 
     Returns
     -------
@@ -78,9 +83,11 @@ def extract_frames(
     KeypointError
         Unknown backend, no frames, or frames of changing size.
     """
-    est = estimator if estimator is not None else _make_backend(backend, model, threads, smooth, markers)
+    est = estimator if estimator is not None else _make_backend(backend, model, threads, smooth, markers, bool(flip_test))
     if hasattr(est, "smooth"):
         est.smooth = bool(smooth)
+    if flip_test is not None and hasattr(est, "flip_test"):
+        est.flip_test = bool(flip_test)
     est.reset()
     times, xy, vis, pres, world, crops = [], [], [], [], [], []
     size = None
@@ -135,6 +142,7 @@ def extract(
     markers=None,
     estimator=None,
     progress: bool = False,
+    flip_test: bool | None = None,
 ) -> KeypointTrack:
     """Keypoints of a video file or image folder.
 
@@ -149,7 +157,7 @@ def extract(
         Frame rate of an image folder (default 30) or override for a file.
     start, stop : int
         Frame range ``[start, stop)``.
-    threads, smooth, markers, estimator
+    threads, smooth, markers, estimator, flip_test
         As :func:`extract_frames`.
     progress : bool
         Show a tqdm progress bar on stderr.
@@ -163,7 +171,7 @@ def extract(
     if not progress:
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
-            markers=markers, estimator=estimator,
+            markers=markers, estimator=estimator, flip_test=flip_test,
         )  # fmt: skip
     from tqdm import tqdm
 
@@ -171,5 +179,5 @@ def extract(
     with tqdm(total=total, unit="frame", desc=f"keypoints ({backend})") as bar:
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
-            markers=markers, estimator=estimator, progress=lambda _i: bar.update(1),
+            markers=markers, estimator=estimator, progress=lambda _i: bar.update(1), flip_test=flip_test,
         )  # fmt: skip

@@ -19,7 +19,9 @@ __all__ = ["capture"]
 @click.option("--grid", default="1/4", show_default=True, help="Beat grid of starts and durations, e.g. 1/4 or 1/2.")
 @click.option("--no-effort", is_flag=True, help="Skip the Laban Effort estimate (the slowest step).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Effort posteriors.")
-def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed):
+@click.option("--flip-test", is_flag=True,
+              help="BlazePose also reads a mirrored copy of each crop (more accurate in side views; slower).")
+def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
     into notation files in OUTDIR."""
     from fractions import Fraction
@@ -36,7 +38,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         raise PipelineError(f"--grid {grid!r} must be > 0 beats")
     tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
     result = run(input_path, outdir, backend=backend, tempo=tempo_value, fps_override=fps_override, progress=True,
-                 params=SegmentParams(grid=step), effort=not no_effort, seed=seed)
+                 params=SegmentParams(grid=step), effort=not no_effort, seed=seed, flip_test=flip_test)
     how = "estimated" if result.segmentation.tempo_estimated else "given"
     click.echo(f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
                f"({result.kind}), tempo {result.score.tempo} bpm ({how})")

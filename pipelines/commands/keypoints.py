@@ -17,7 +17,10 @@ from capture2notation.keypoints import BACKENDS, extract
 @click.option("--threads", type=int, default=2, show_default=True, help="onnxruntime threads.")
 @click.option("--no-smooth", is_flag=True, help="Disable the one-euro temporal filter.")
 @click.option("--markers", "markers_file", type=click.Path(exists=True, dir_okay=False), default=None, help="JSON marker colours for --backend markers (default: the renderer's).")
-def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, markers_file):
+@click.option("--flip-test", is_flag=True,
+              help="Also read a mirrored copy of each crop and keep the reading facing the right way "
+                   "(more accurate in side views and folded arms; about half the speed).")
+def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, markers_file, flip_test):
     """Extract 33 BlazePose keypoints per frame from VIDEO (file or image folder)."""
     markers = None
     if markers_file:
@@ -25,7 +28,8 @@ def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, m
 
         markers = read_marker_specs(markers_file)
     track = extract(
-        video, backend, model=model, fps=fps, threads=threads, smooth=not no_smooth, markers=markers, progress=True
+        video, backend, model=model, fps=fps, threads=threads, smooth=not no_smooth, markers=markers, progress=True,
+        flip_test=flip_test,
     )
     track.save(output)
     seen = float((track.presence > 0).mean()) if len(track) else 0.0

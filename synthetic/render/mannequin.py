@@ -1,10 +1,12 @@
 """The shaded mannequin: capsule limbs, a clothed torso, a head with a face.
 
 Made to look like a person to a pose model at little cost: a shirt and
-trousers of different colours, skin-coloured forearms, hands and head, dark
-shoes on feet that point forward, hair at the back of the head and a face
-(eyes, brows, nose, mouth, ears) that turns with the head so front and back
-are told apart.  Shading is three nested, light-shifted layers of each shape
+trousers of different colours, skin-coloured forearms, hands and head,
+trousers ending just above the ankle and dark shoes (heel, instep, toes)
+just below it so the leg visibly meets the foot at the ankle joint, hair at
+the back of the head and a face (eyes, brows, nose, mouth, ears) that turns
+with the head so front and back are told apart; the hair covers the face
+only when the head faces away from the camera.  Shading is three nested, light-shifted layers of each shape
 (dark rim, body colour, highlight): no per-pixel work.
 
 All geometry is computed for every frame at once; :meth:`Mannequin.frame`
@@ -49,7 +51,7 @@ _PART_COLOUR = {
     "neck": "skin", "head": "skin", "shoulders": "shirt", "chest": "shirt", "belly": "shirt",
     "pelvis": "trousers", "hips": "trousers",
     "upper_arm": "shirt", "forearm": "skin", "hand": "skin", "fingers": "skin", "thumb": "skin",
-    "thigh": "trousers", "shin": "trousers", "foot": "shoes",
+    "thigh": "trousers", "shin": "trousers", "lower_leg": "skin", "foot": "shoes", "instep": "shoes", "toes": "shoes",
 }
 # Drawn otherwise: the torso capsules as clothed hulls, the head as ellipses.
 _HULL_PARTS = {"shoulders", "chest", "belly", "pelvis", "hips", "head"}
@@ -239,7 +241,6 @@ class Mannequin:
             J = f / z[:, None, None] * cam.R[None, :2]  # (T,2,3)
             M = J @ (np.swapaxes(axes, 1, 2) * r)
             half, angle = _ellipse_params(M @ np.swapaxes(M, 1, 2))
-            out[key + "_depth"] = z
             for scale, shift in _HEAD_LAYERS:
                 out[(key, scale)] = (
                     fixed(uv + shift * half[:, :1] * LIGHT).tolist(),
@@ -256,7 +257,13 @@ class Mannequin:
         cos = {n: np.sum((pose.points[n] - centre) * to_cam, 1) / np.linalg.norm(pose.points[n] - centre, axis=1)
                for n in _FACE_POINTS}
         side = np.sum(axes[:, 0] * to_cam, axis=1)  # > 0: the right ear is seen
-        facing = np.sum(axes[:, 1] * to_cam, axis=1) > -0.3
+        facing_cos = np.sum(axes[:, 1] * to_cam, axis=1)
+        facing = facing_cos > -0.3
+        # The hair covers the face only when the head faces away.  (Ordering
+        # the two ellipsoids by centre depth put the hair, which sits higher,
+        # over the face of a head tilted back and seen from below: the pose
+        # model then read the body as seen from behind.)
+        out["hair_on_top"] = (facing_cos < -0.3).tolist()
         r = np.maximum(1.0, 0.016 * s)
         ear_axes = fixed(np.stack([0.6 * r, r], 1)).tolist()
         out["ears"] = [
@@ -350,12 +357,12 @@ class Mannequin:
 
     def _draw_head(self, img, i: int) -> None:
         hd, col = self._head, self._head_colours
-        skin_first = hd["skin_depth"][i] >= hd["hair_depth"][i]
-        order = ("skin", "hair") if skin_first else ("hair", "skin")
+        hair_on_top = hd["hair_on_top"][i]
+        order = ("skin", "hair") if hair_on_top else ("hair", "skin")
         for key in order:
             self._ellipse(img, key, 1.0, i, col[key + "_rim"])
             self._ellipse(img, key, 0.86, i, col[key])
-        if not skin_first:
+        if not hair_on_top:
             # Hair behind: the face shows; its highlight sits on the forehead side.
             self._ellipse(img, "skin", 0.45, i, col["skin_light"])
         show_r, c_r, a_r, show_l, c_l, a_l = hd["ears"]

@@ -45,10 +45,20 @@ EXTRA_POINTS: dict[str, tuple[str, tuple[float, float, float]]] = {
     "chin": ("neck", (0.0, 0.012, 0.865)),
     "neck_base": ("chest", (0.0, 0.0, 0.834)),  # above the neck joint: the neck ends inside the collar
     "nose_root": ("neck", (0.0, 0.054, 0.929)),
-    "right_heel_top": ("right_ankle", (0.055, -0.022, 0.022)),
-    "left_heel_top": ("left_ankle", (-0.055, -0.022, 0.022)),
-    "right_toe_top": ("right_ankle", (0.055, 0.105, 0.016)),
-    "left_toe_top": ("left_ankle", (-0.055, 0.105, 0.016)),
+    # The trousers end just above the ankle joint and the shoe just below it,
+    # so the leg meets the foot at the ankle in every view (with a bare strip
+    # where the camera sees under the hem), where a person would mark it.
+    # Trousers down over the shoe hid that junction from the pose model.
+    "right_hem": ("right_knee", (0.055, 0.0, 0.080)),
+    "left_hem": ("left_knee", (-0.055, 0.0, 0.080)),
+    "right_heel_top": ("right_ankle", (0.055, -0.020, 0.021)),
+    "right_instep": ("right_ankle", (0.055, 0.028, 0.025)),
+    "left_heel_top": ("left_ankle", (-0.055, -0.020, 0.021)),
+    "left_instep": ("left_ankle", (-0.055, 0.028, 0.025)),
+    "right_ball": ("right_ankle", (0.055, 0.085, 0.018)),
+    "left_ball": ("left_ankle", (-0.055, 0.085, 0.018)),
+    "right_toe_top": ("right_ankle", (0.055, 0.112, 0.013)),
+    "left_toe_top": ("left_ankle", (-0.055, 0.112, 0.013)),
     "right_hand_mid": ("right_wrist", (0.117, 0.004, 0.432)),
     "left_hand_mid": ("left_wrist", (-0.117, 0.004, 0.432)),
 }
@@ -77,11 +87,17 @@ CAPSULES: tuple[tuple[str, str, str, float, float], ...] = (
     ("left_fingers", "left_hand_mid", "left_hand_tip", 0.017, 0.010),
     ("left_thumb", "left_wrist", "left_thumb", 0.011, 0.008),
     ("right_thigh", "right_hip", "right_knee", 0.055, 0.036),
-    ("right_shin", "right_knee", "right_ankle", 0.035, 0.024),
-    ("right_foot", "right_heel_top", "right_toe_top", 0.021, 0.017),
+    ("right_shin", "right_knee", "right_hem", 0.035, 0.027),
+    ("right_lower_leg", "right_hem", "right_ankle", 0.023, 0.020),
+    ("right_foot", "right_heel_top", "right_ball", 0.021, 0.019),
+    ("right_instep", "right_instep", "right_ball", 0.019, 0.018),
+    ("right_toes", "right_ball", "right_toe_top", 0.020, 0.012),
     ("left_thigh", "left_hip", "left_knee", 0.055, 0.036),
-    ("left_shin", "left_knee", "left_ankle", 0.035, 0.024),
-    ("left_foot", "left_heel_top", "left_toe_top", 0.021, 0.017),
+    ("left_shin", "left_knee", "left_hem", 0.035, 0.027),
+    ("left_lower_leg", "left_hem", "left_ankle", 0.023, 0.020),
+    ("left_foot", "left_heel_top", "left_ball", 0.021, 0.019),
+    ("left_instep", "left_instep", "left_ball", 0.019, 0.018),
+    ("left_toes", "left_ball", "left_toe_top", 0.020, 0.012),
 )
 
 _CHUNK = 256  # frames per block in the visibility test

@@ -1,31 +1,9 @@
-"""Keypoint-stage fixtures: the pose model fetched once per test session."""
+"""Keypoint-stage fixtures: one onnxruntime session per test session (the model comes from
+``pose_model_path`` in ``tests/conftest.py``)."""
 
 from __future__ import annotations
 
-import os
-
 import pytest
-
-from capture2notation.errors import ModelError
-
-
-@pytest.fixture(scope="session")
-def pose_model_path():
-    """Path of the BlazePose ONNX model, fetched on first use.
-
-    Skips (with the reason) only when the model cannot be fetched, e.g. no
-    access to the package index; with ``C2N_REQUIRE_MODEL=1`` (set in CI) that
-    is a failure instead.
-    """
-    from capture2notation.keypoints.model import resolve_model
-
-    try:
-        return resolve_model()
-    except ModelError as exc:
-        if os.environ.get("C2N_REQUIRE_MODEL") == "1":
-            pytest.fail(f"C2N_REQUIRE_MODEL=1 but the pose model is unavailable: {exc}")
-        pytest.skip(f"BlazePose model unavailable (fetch impossible here): {exc}")
-
 
 @pytest.fixture(scope="session")
 def blazepose_session(pose_model_path):
@@ -34,14 +12,12 @@ def blazepose_session(pose_model_path):
 
     return make_session(pose_model_path, threads=2)
 
-
 @pytest.fixture
 def blazepose(blazepose_session):
     """A fresh tracker reusing the shared session."""
     from capture2notation.keypoints.blazepose import BlazePose
 
     return BlazePose(session=blazepose_session)
-
 
 def _demo_pose(n_frames: int = 12, fps: float = 25.0):
     """Arms raise (one sideways, one forward), elbows bend, one leg lifts.
@@ -67,7 +43,6 @@ def _demo_pose(n_frames: int = 12, fps: float = 25.0):
     root = np.zeros((n_frames, 3))
     root[:, 2] = Body().rest[0, 2]
     return scene.Pose(a, root, Body(), fps)
-
 
 @pytest.fixture
 def demo_pose():

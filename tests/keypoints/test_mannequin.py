@@ -7,14 +7,15 @@ height in pixels is the body height projected at the pelvis depth
 left/right swap is a frame where both points of a pair lie nearer the
 opposite side's truth while the two truths are more than the PCK radius apart.
 
-Measured (built-in phrases at 5 and 10 fps, see the report):
-front meets it except the ankles (0.87-0.92: BlazePose puts the ankle ~9 px
-above the mannequin's ankle joint); at 45 degrees ``port_de_bras`` with both
-arms overhead is read as seen from behind for 7 frames (a whole-body swap);
-in the side view the near elbow, tucked in front of the chest, is just over
-the radius in some frames.  The renderer is still changing, so the asserted
-floor is 75 % per joint (and no swaps front and side); the issue's target is
-kept as a non-strict ``xfail`` that reports the shortfall.
+Measured on the built-in phrases at 5 fps (bench_keypoints.py gives 10 fps):
+with the flip test (``flip_test=True``: the model also reads the mirrored
+crop) every joint in every view is >= 0.97 and nothing is swapped; one pass
+per frame (the default) is >= 0.97 front and at 45 degrees, but in profile
+the near elbow (0.91: arm raised towards the camera or folded in front of
+the face) and the far ankle (0.95) fall short.  BlazePose still puts the
+ankles 6-9 px (about 0.025 H) above the body's ankle joint.  So the issue's
+target is asserted with the flip test, and a floor plus "no swaps" on the
+default path.
 """
 
 from __future__ import annotations
@@ -27,22 +28,19 @@ pytestmark = pytest.mark.model
 FPS = 5.0  # low frame rate keeps the test fast; tracking copes (the squats fixture is 5 fps)
 
 
-def _evaluate(blazepose, view):
-    """PCK per joint name (e.g. ``elbow_L``) and swap counts per pair over the built-in phrases."""
-    render = pytest.importorskip("synthetic.render")
-    phrases = pytest.importorskip("synthetic.phrases")
-    from capture2notation.body import Body
+def _evaluate(blazepose, poses, view, flip_test):
+    """PCK per joint name (e.g. ``elbow_L``) and swap counts per pair over the phrases' poses."""
     from capture2notation.keypoints import extract_frames
     from capture2notation.keypoints.evaluate import PAIRS, left_right_swaps, person_height_px
-    from synthetic.interpret import interpret
+    from synthetic import render
 
     hits = {f"{j}_{s}": [] for j in PAIRS for s in "LR"}
     swaps = dict.fromkeys(PAIRS, 0)
-    for _name, score in sorted(phrases.builtin_phrases().items()):
-        pose = render.Pose.from_motion(interpret(score, FPS, Body()))
+    for pose in poses:
         cam = render.Camera.for_view(view, (640, 480), pose.body.height)
         truth = render.truth_fields(pose, cam)
-        track = extract_frames(render.render_frames(pose, cam, "mannequin"), pose.fps, estimator=blazepose)
+        frames = render.render_frames(pose, cam, "mannequin")
+        track = extract_frames(frames, pose.fps, estimator=blazepose, flip_test=flip_test)
         radius = 0.05 * person_height_px(cam.K, cam.R, cam.t, pose.root, pose.body.height)
         err = np.linalg.norm(track.xy[:, :, :2] - truth["keypoints"], axis=-1)
         ok = np.where(np.isfinite(err), err, np.inf) <= radius[:, None]
@@ -53,33 +51,36 @@ def _evaluate(blazepose, view):
         for j, frames in left_right_swaps(track.xy, truth["keypoints"], radius).items():
             swaps[j] += int(frames.sum())
     pck = {k: float(np.mean(v)) if v else float("nan") for k, v in hits.items()}
-    print(f"\n{view}: PCK@5% " + " ".join(f"{k}={v:.3f}" for k, v in pck.items()) + f"; swaps {swaps}")
+    print(f"\n{view} (flip test {flip_test}): PCK@5% " + " ".join(f"{k}={v:.3f}" for k, v in pck.items()) + f"; swaps {swaps}")
     return pck, swaps
 
 
 @pytest.fixture(scope="module")
 def results(blazepose_session):
+    render = pytest.importorskip("synthetic.render")
+    phrases = pytest.importorskip("synthetic.phrases")
+    from capture2notation.body import Body
     from capture2notation.keypoints.blazepose import BlazePose
+    from synthetic.interpret import interpret
 
+    poses = [render.Pose.from_motion(interpret(score, FPS, Body())) for _, score in sorted(phrases.builtin_phrases().items())]
     bp = BlazePose(session=blazepose_session)
-    return {view: _evaluate(bp, view) for view in ("front", "45", "side")}
+    return {(view, flip): _evaluate(bp, poses, view, flip) for view in ("front", "45", "side") for flip in (False, True)}
 
 
 @pytest.mark.parametrize("view", ["front", "45", "side"])
-def test_every_joint_is_mostly_found(results, view):
-    """A floor that holds in every view while the mannequin evolves (measured >= 0.83)."""
-    pck, swaps = results[view]
-    low = {k: round(v, 3) for k, v in pck.items() if np.isfinite(v) and v < 0.75}
-    assert not low, f"{view}: PCK@5% below 75 %: {low}"
-    if view != "45":
-        assert sum(swaps.values()) == 0, f"{view}: left/right swaps {swaps}"
+def test_one_pass_per_frame_finds_every_joint_without_swaps(results, view):
+    """The default path: a floor (measured >= 0.89) and no left/right swaps."""
+    pck, swaps = results[view, False]
+    low = {k: round(v, 3) for k, v in pck.items() if np.isfinite(v) and v < 0.85}
+    assert not low, f"{view}: PCK@5% below 85 %: {low}"
+    assert sum(swaps.values()) == 0, f"{view}: left/right swaps {swaps}"
 
 
-@pytest.mark.xfail(strict=False, reason="issue target not met yet on the mannequin; see the module docstring and report")
 @pytest.mark.parametrize("view", ["front", "45", "side"])
 def test_issue_target_pck95_and_no_swaps(results, view):
-    """The issue's target; an XPASS here means the mannequin now meets it."""
-    pck, swaps = results[view]
+    """The issue's target, met with the flip test."""
+    pck, swaps = results[view, True]
     low = {k: round(v, 3) for k, v in pck.items() if np.isfinite(v) and v < 0.95}
     assert not low, f"{view}: PCK@5% below 95 %: {low}"
     assert sum(swaps.values()) == 0, f"{view}: left/right swaps {swaps}"
