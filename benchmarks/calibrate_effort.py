@@ -13,12 +13,14 @@ who vary about the preset (``emotion.PERFORMER_SD``).  A calibration set
 test set (seed 2006) gives the 4-way confusion matrix and Neagle's
 Experiment 1 same/different judgements (% correct overall and per pair).
 
-Through BlazePose: :func:`recovery_through_capture` takes the capture path
-as a function, for the lead to call once video → 3D joints is wired.
+Through BlazePose (``--blazepose N``): :func:`recovery_through_capture`
+with :func:`blazepose_capture` renders each performance, reads it back with
+``pipelines.capture.capture`` (BlazePose, 3D fitting) and scores the Effort
+estimated from those joints.
 
 Usage::
 
-    /work/venv/bin/python benchmarks/calibrate_effort.py [--quick] [--derive] [--workers 2]
+    /work/venv/bin/python benchmarks/calibrate_effort.py [--quick] [--derive] [--workers 2] [--blazepose N]
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from capture2notation.body import JOINTS
 from capture2notation.effort import estimate_effort
 from capture2notation.effort.emotion import (
     PERFORMER_SD,
@@ -138,6 +141,37 @@ def recovery_through_capture(capture_fn, n_perf: int = 30, seed: int = 1974):
     return recovery(n_perf, seed, 0.0, 1, capture_fn=capture_fn, title="recovery through the capture path")
 
 
+def blazepose_capture(score, fps=FPS, size=(640, 480), view="front"):
+    """A `capture_fn` for :func:`recovery_through_capture`: render → BlazePose → 3D joints.
+
+    The virtual dancer performs and the renderer films `score`
+    (``synthetic.render.render_score``); ``pipelines.capture.capture``
+    (BlazePose keypoints and 3D fitting, Effort off) reads the video back.
+
+    Returns
+    -------
+    joints (T, J, 3), confidence (T, J), fps, times (T,)
+        From the capture's ``capture.npz``.
+    """
+    import tempfile
+    from pathlib import Path
+
+    from pipelines.capture import capture
+    from synthetic.render.job import render_score
+
+    with tempfile.TemporaryDirectory(prefix="c2n-effort-cal-") as tmp:
+        tmp = Path(tmp)
+        render_score(score, tmp / "render", fps=fps, size=size, view=view, progress=False)
+        capture(tmp / "render" / "video.mp4", tmp / "capture", effort=False, overlay=False, progress=False,
+                tempo=float(score.tempo))
+        with np.load(tmp / "capture" / "capture.npz") as z:
+            names = tuple(str(n) for n in z["joint_names"])
+            if names != tuple(JOINTS):
+                raise RuntimeError(f"capture joints {names} differ from the canonical {tuple(JOINTS)}")
+            return (np.asarray(z["joints"], float), np.asarray(z["confidence"], float), float(z["fps"]),
+                    np.asarray(z["times"], float))
+
+
 # --- emotion -------------------------------------------------------------------
 def _performer(rng, emotion: str):
     """Effort and tempo of one synthetic performer of `emotion` (preset + variation)."""
@@ -217,12 +251,16 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--skip-recovery", action="store_true")
     ap.add_argument("--skip-emotion", action="store_true")
+    ap.add_argument("--blazepose", type=int, default=0, metavar="N",
+                    help="Also part 1 through render -> BlazePose -> 3D fitting on N performances (slow).")
     a = ap.parse_args(argv)
     n_perf, n_emo = (6, 6) if a.quick else (40, 30)
     print(f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs (synthetic.interpret missing)'}")
     if not a.skip_recovery:
         recovery(n_perf, 1974, 0.0, a.workers)
         recovery(n_perf, 1974, 0.005, a.workers)
+    if a.blazepose:
+        recovery_through_capture(blazepose_capture, n_perf=a.blazepose)
     if not a.skip_emotion:
         t0 = time.perf_counter()
         cal = emotion_set(n_emo, 2005, a.workers)

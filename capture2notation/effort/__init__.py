@@ -11,7 +11,7 @@ from .estimate import EffortResult, MovementEffort, estimate_effort, movement_wi
 from .fit import fit_logistic, fit_space
 from .model import TIME_RANGE, WEIGHT_RANGE, progress, progress_speed, space_radius
 from .pooled import PooledEffort, pooled_posterior
-from .posterior import Posterior, sample_posterior
+from .posterior import Posterior, sample_posterior, sample_posteriors
 from .presets import PRESETS, Preset
 from .report import write_effort
 
@@ -36,6 +36,7 @@ __all__ = [
     "progress_speed",
     "same_or_different",
     "sample_posterior",
+    "sample_posteriors",
     "space_radius",
     "write_effort",
 ]

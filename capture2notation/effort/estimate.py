@@ -20,7 +20,7 @@ from .curves import SNAP_S, ProgressCurve, progress_curve
 from .emotion import emotion_probabilities, features
 from .fit import SpaceEstimate, fit_space
 from .pooled import PooledEffort, pool_curves
-from .posterior import Posterior, sample_posterior
+from .posterior import Posterior, sample_posteriors
 
 __all__ = ["EffortResult", "MovementEffort", "estimate_effort", "movement_windows"]
 
@@ -126,10 +126,38 @@ def movement_windows(score: Score, times: np.ndarray) -> list:
     return out
 
 
+#: Posteriors sampled together in one vectorised emcee run (a fixed size, so
+#: results do not depend on the number of worker processes).
+CHUNK = 24
+
+
 def _sample_job(args):
-    """Worker: one posterior (top-level so process pools can pickle it)."""
-    tau, s, w, groups, seed, kw = args
-    return sample_posterior(tau, s, w, rng=seed, groups=groups, **kw)
+    """Worker: one chunk of posteriors (top-level so process pools can pickle it)."""
+    datasets, seed, kw = args
+    return sample_posteriors(datasets, rng=seed, **kw)
+
+
+def _sample_all(jobs, rng, workers: int, kw: dict, chunk: int | None = None) -> list:
+    """Posteriors of `jobs` ((tau, s, w, groups) each), in order.
+
+    Jobs are dealt round-robin into ``ceil(len / chunk)`` chunks (so the
+    large pooled sets spread out), each sampled in one vectorised run with
+    its own seed; chunks go to `workers` processes when there are several.
+    """
+    n_chunks = -(-len(jobs) // (chunk or CHUNK))
+    members = [list(range(i, len(jobs), n_chunks)) for i in range(n_chunks)]
+    seeds = rng.integers(0, 2**63 - 1, size=n_chunks)
+    args = [([jobs[i] for i in m], int(seed), kw) for m, seed in zip(members, seeds)]
+    if workers > 1 and n_chunks > 1:
+        with concurrent.futures.ProcessPoolExecutor(max_workers=min(workers, n_chunks)) as ex:
+            done = list(ex.map(_sample_job, args))
+    else:
+        done = [_sample_job(a) for a in args]
+    posts = [None] * len(jobs)
+    for m, ps in zip(members, done):
+        for i, p in zip(m, ps):
+            posts[i] = p
+    return posts
 
 
 def estimate_effort(
@@ -164,9 +192,11 @@ def estimate_effort(
     joint_names : sequence of str
         Names of the J joints.
     workers : int
-        Processes for the posteriors (1 = in this process).
+        Processes for the posteriors (1 = in this process).  All posteriors
+        (movements and pooled sets) are sampled in vectorised chunks of
+        :data:`CHUNK`; extra processes pay off only beyond one chunk.
     sampler_kw : dict, optional
-        Passed to :func:`.posterior.sample_posterior`.
+        Passed to :func:`.posterior.sample_posteriors`.
     per_movement : bool
         Sample each movement's posterior (False: pooled estimates only, for
         studies that need the phrase's Effort alone).
@@ -221,13 +251,7 @@ def estimate_effort(
     jobs = [(c.tau, c.s, c.weight, None) for c in curves] if per_movement else []
     n_mov = len(jobs)
     jobs += [(t, s, w, g) for t, s, w, _, g in (pool_curves(cs) for _, cs in groups)]
-    seeds = rng.integers(0, 2**63 - 1, size=len(jobs))
-    args = [(*job, int(seed), kw) for job, seed in zip(jobs, seeds)]
-    if workers > 1 and len(args) > 1:
-        with concurrent.futures.ProcessPoolExecutor(max_workers=workers) as ex:
-            posts = list(ex.map(_sample_job, args))
-    else:
-        posts = [_sample_job(a) for a in args]
+    posts = _sample_all(jobs, rng, workers, kw) if jobs else []
 
     movements = tuple(
         MovementEffort(

@@ -10,12 +10,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import optimize, special, stats
 
 from ..errors import EffortError
 from .model import TIME_RANGE, WEIGHT_RANGE, progress
 
-__all__ = ["INWARD_DEPTH", "LogisticFit", "SpaceEstimate", "fit_logistic", "fit_space"]
+__all__ = ["INWARD_DEPTH", "LogisticFit", "SpaceEstimate", "fit_logistic", "fit_logistic_many", "fit_space"]
 
 #: Depth of the inward Space modulation at S = 0 (Neagle eq. 5.5: 0.1·r).
 INWARD_DEPTH = 0.1
@@ -63,10 +63,28 @@ def _truncnorm_summary(mu: float, sd: float, lo: float, hi: float, mass: float =
     The highest-density interval reaches the bound when the mode sits on it
     (an equal-tailed interval would then exclude the most probable values).
     """
-    dist = stats.truncnorm((lo - mu) / sd, (hi - mu) / sd, loc=mu, scale=sd)
-    if not np.isfinite(dist.ppf(0.5)):  # all mass far beyond one end
-        v = float(np.clip(mu, lo, hi))
-        return v, v, v
+    za, zb = (lo - mu) / sd, (hi - mu) / sd
+    # Φ differences from the nearer tail keep their precision; scipy's
+    # truncnorm (log-space, 100x slower) only where even that underflows
+    flip = za > 0
+    z_mass = special.ndtr(-za) - special.ndtr(-zb) if flip else special.ndtr(zb) - special.ndtr(za)
+    if z_mass > 1e-12:
+        if flip:
+            def cdf(x):
+                return (special.ndtr(-za) - special.ndtr(-(x - mu) / sd)) / z_mass
+
+            median = mu - sd * special.ndtri(special.ndtr(-za) - 0.5 * z_mass)
+        else:
+            def cdf(x):
+                return (special.ndtr((x - mu) / sd) - special.ndtr(za)) / z_mass
+
+            median = mu + sd * special.ndtri(special.ndtr(za) + 0.5 * z_mass)
+    else:
+        dist = stats.truncnorm(za, zb, loc=mu, scale=sd)
+        cdf, median = dist.cdf, dist.ppf(0.5)
+        if not np.isfinite(median):  # all mass far beyond one end
+            v = float(np.clip(mu, lo, hi))
+            return v, v, v
     mode = float(np.clip(mu, lo, hi))
     # widen a symmetric-in-density window [mode - h, mode + h] ∩ [lo, hi]
     h_lo, h_hi = 0.0, hi - lo
@@ -75,11 +93,11 @@ def _truncnorm_summary(mu: float, sd: float, lo: float, hi: float, mass: float =
         a, b = max(mu - h, lo), min(mu + h, hi)
         if mode in (lo, hi):
             a, b = (lo, min(lo + h, hi)) if mode == lo else (max(hi - h, lo), hi)
-        if dist.cdf(b) - dist.cdf(a) < mass:
+        if cdf(b) - cdf(a) < mass:
             h_lo = h
         else:
             h_hi = h
-    return float(a), float(dist.ppf(0.5)), float(b)
+    return float(a), float(np.clip(median, lo, hi)), float(b)
 
 
 def _check(tau, y, weight):
@@ -135,6 +153,100 @@ def fit_logistic(tau, s, weight=None, sd_floor_sigma: float = 1e-4) -> LogisticF
         var = max(sigma, sd_floor_sigma) ** 2 * np.mean(w) * np.diag(np.linalg.inv(jtj))
         sd = tuple(float(v) for v in np.sqrt(np.abs(var)))
     return LogisticFit(b=float(best.x[0]), x0=float(best.x[1]), sigma=sigma, cost=float(best.cost), sd=sd)
+
+
+#: Starting points (b, x0) of the least-squares searches (as in fit_logistic).
+_STARTS = ((-4.0, 0.35), (-4.0, 0.6), (-2.5, 0.35), (-2.5, 0.6))
+
+
+def _model_and_jacobian(b, x0, logtau):
+    """progress(τ; b, x0) and its partial derivatives in b and x0, elementwise (E,)."""
+    lnx = np.log(x0)
+    xb = np.exp(-b * lnx)  # x0^−b = (1/x0)^b
+    amp = 1.0 + xb
+    r = np.exp(b * (logtau - lnx))  # (τ/x0)^b
+    inv = 1.0 / (1.0 + r)
+    m = amp * inv
+    # ds/dp = (da/dp)/(1 + r) − a (dr/dp)/(1 + r)²
+    d_b = (-lnx * xb) * inv - m * inv * r * (logtau - lnx)
+    d_x = (-b * xb / x0) * inv + m * inv * r * b / x0
+    return m, d_b, d_x
+
+
+def fit_logistic_many(datasets, iterations: int = 60, sd_floor_sigma: float = 1e-4) -> list:
+    """:func:`fit_logistic` for many data sets at once (vectorised Levenberg–Marquardt).
+
+    Every data set is fitted from the same four starts as :func:`fit_logistic`
+    by a projected Levenberg–Marquardt iteration within the working ranges,
+    all starts of all data sets advancing together; the best start wins.
+
+    Parameters
+    ----------
+    datasets : sequence of (tau, s, weight)
+        Per data set (N,) arrays as for :func:`fit_logistic` (weight may be None).
+    iterations : int
+        Levenberg–Marquardt iterations (it stops earlier once no step helps).
+    sd_floor_sigma : float
+        Smallest noise level assumed for the standard errors ``sd``.
+
+    Returns
+    -------
+    list of LogisticFit
+    """
+    data = [_check(*d) for d in datasets]
+    if not data:
+        return []
+    ns = np.array([d[0].size for d in data])
+    logtau = np.log(np.concatenate([d[0] for d in data]))
+    s = np.concatenate([d[1] for d in data])
+    w = np.concatenate([d[2] for d in data])
+    n_start = len(_STARTS)
+    rows = np.arange(ns.size * n_start)  # row = data set · n_start + start
+    offsets = np.concatenate([[0], np.cumsum(ns)])
+    row_of = np.repeat(rows, np.repeat(ns, n_start))  # (E,)
+    col = np.concatenate([np.tile(np.arange(offsets[g], offsets[g + 1]), n_start) for g in range(ns.size)])
+    lt, ss, ww = logtau[col], s[col], w[col]
+    lo = np.array([TIME_RANGE[0], WEIGHT_RANGE[0]])
+    hi = np.array([TIME_RANGE[1], WEIGHT_RANGE[1]])
+    p = np.tile(np.array(_STARTS, dtype=float), (ns.size, 1))  # (R, 2)
+
+    def evaluate(p):
+        m, db, dx = _model_and_jacobian(p[row_of, 0], p[row_of, 1], lt)
+        r = m - ss
+        nr = rows.size
+        cost = 0.5 * np.bincount(row_of, ww * r * r, nr)
+        jtj = np.stack([np.bincount(row_of, ww * a * c, nr) for a, c in ((db, db), (db, dx), (dx, dx))], axis=1)
+        jtr = np.stack([np.bincount(row_of, ww * a * r, nr) for a in (db, dx)], axis=1)
+        return cost, jtj, jtr
+
+    cost, jtj, jtr = evaluate(p)
+    lam = np.full(rows.size, 1e-3)
+    for _ in range(iterations):
+        a11, a12, a22 = jtj[:, 0] * (1 + lam), jtj[:, 1], jtj[:, 2] * (1 + lam)
+        det = a11 * a22 - a12 * a12
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = -np.column_stack([a22 * jtr[:, 0] - a12 * jtr[:, 1], a11 * jtr[:, 1] - a12 * jtr[:, 0]]) / det[:, None]
+        step = np.nan_to_num(step)
+        trial = np.clip(p + step, lo + 1e-6, hi - 1e-6)
+        c_new, jtj_new, jtr_new = evaluate(trial)
+        better = c_new < cost
+        if not better.any() and np.all(lam > 1e6):
+            break
+        p[better], cost[better] = trial[better], c_new[better]
+        jtj[better], jtr[better] = jtj_new[better], jtr_new[better]
+        lam = np.where(better, lam / 3.0, lam * 4.0)
+    best = np.argmin(cost.reshape(ns.size, n_start), axis=1) + np.arange(ns.size) * n_start
+    out = []
+    for g, r in enumerate(best):
+        mean_w = float(np.mean(data[g][2]))
+        sigma = float(np.sqrt(2 * cost[r] / max(ns[g] - 2, 1) / mean_w))
+        mat = np.array([[jtj[r, 0], jtj[r, 1]], [jtj[r, 1], jtj[r, 2]]])
+        sd = (np.inf, np.inf)
+        if np.linalg.cond(mat) < 1e12:
+            var = max(sigma, sd_floor_sigma) ** 2 * mean_w * np.diag(np.linalg.inv(mat))
+            sd = tuple(float(v) for v in np.sqrt(np.abs(var)))
+        out.append(LogisticFit(b=float(p[r, 0]), x0=float(p[r, 1]), sigma=sigma, cost=float(cost[r]), sd=sd))
+    return out
 
 
 def fit_space(tau, radial, weight=None) -> SpaceEstimate:

@@ -3,13 +3,23 @@
 Likelihood: ``s_i = progress(τ_i; b, x0) + ε_i``, ``ε_i ~ N(0, σ² / w_i)``
 with ``w_i`` the frame's confidence.  Priors: uniform on the working ranges
 ``TIME_RANGE`` × ``WEIGHT_RANGE`` and uniform on ln σ in :data:`LOG_SIGMA_RANGE`
-(scale-free noise prior).  The log-probability is vectorised over walkers.
+(scale-free noise prior).  :func:`log_probability` is this joint
+log-posterior, vectorised over walkers.
+
+The sampler works on its exact marginal over ln σ (and over each movement's
+free offset and end scale; :mod:`.likelihood`), so emcee explores two
+dimensions only, and ln σ is drawn afterwards from its exact conditional
+given each (b, x0) sample.  :func:`sample_posteriors` runs many posteriors
+as independent ensembles inside one vectorised emcee sampler
+(:mod:`.sampler`), which is how :func:`~.estimate.estimate_effort` samples a
+phrase; :func:`sample_posterior` is the one-posterior case.
 
 Convergence follows emcee's documentation (Autocorrelation analysis &
-convergence): the chain is extended in blocks until it is longer than
+convergence): each chain is extended in blocks until it is longer than
 :data:`N_TAU` integrated autocorrelation times and the τ estimate moved by
-less than ``tau_rtol`` (5 %; the tutorial's example uses 1 %); burn-in is 2·max τ and thinning τ_min / 2.  A run that hits
-``max_steps`` first is returned with ``converged = False``.
+less than ``tau_rtol`` (5 %; the tutorial's example uses 1 %); burn-in is
+2·max τ and thinning τ_min / 2.  A run that hits ``max_steps`` first is
+returned with ``converged = False``.
 """
 
 from __future__ import annotations
@@ -17,21 +27,17 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
-import emcee
 import numpy as np
 
 from ..errors import EffortError
-from .fit import fit_logistic
+from .fit import fit_logistic_many
+from .likelihood import LOG_SIGMA_RANGE, Batch
 from .model import TIME_RANGE, WEIGHT_RANGE
+from .sampler import N_TAU, run_groups
 
-__all__ = ["LOG_SIGMA_RANGE", "N_TAU", "Posterior", "log_probability", "sample_posterior"]
+__all__ = ["LOG_SIGMA_RANGE", "N_TAU", "Posterior", "log_probability", "sample_posterior", "sample_posteriors"]
 
 log = logging.getLogger(__name__)
-
-#: Uniform prior bounds of ln σ (σ from 1e-4 to 0.5 in units of progress).
-LOG_SIGMA_RANGE = (np.log(1e-4), np.log(0.5))
-#: Chain length required, in autocorrelation times (emcee docs: ≥ 50 τ).
-N_TAU = 50
 
 
 @dataclass(frozen=True)
@@ -42,8 +48,9 @@ class Posterior:
     ----------
     samples : (M, 3) ndarray
         Columns b, x0, ln σ after burn-in and thinning.
-    tau : (3,) ndarray
-        Integrated autocorrelation time per parameter, steps.
+    tau : (2,) ndarray
+        Integrated autocorrelation time of b and x0 (the sampled
+        parameters; ln σ is drawn exactly given them), steps.
     acceptance : float
         Mean acceptance fraction over walkers.
     converged : bool
@@ -126,6 +133,82 @@ def log_probability(theta, tau, s, weight, onehot=None):
     return out
 
 
+def sample_posteriors(
+    datasets,
+    rng: np.random.Generator | int | None,
+    free_ends: bool = True,
+    nwalkers: int = 16,
+    block: int = 50,
+    max_steps: int = 6000,
+    tau_rtol: float = 0.05,
+) -> list:
+    """Sample many independent posteriors of (b, x0, ln σ) together.
+
+    Parameters
+    ----------
+    datasets : sequence of (tau, s, weight, groups)
+        Per posterior: (N,) normalised time in (0, 1), progress, confidence
+        (or None) and movement index of each sample (None: one movement;
+        several movements share (b, x0, σ): a pooled estimate).
+    rng : numpy.random.Generator or int
+        Source of every random draw; required so runs are reproducible.
+        Results depend on the whole list (one random stream drives it).
+    free_ends : bool
+        Give each movement a free offset and end scale, marginalised
+        analytically; False pins s(0) = 0 and s(1) = 1 to the observed ends.
+    nwalkers : int
+        Walkers per posterior (even, ≥ 4 = 2 × the 2 sampled dimensions).
+    block : int
+        Steps between convergence checks.
+    max_steps : int
+        Give up (``converged = False``) after this many steps.
+    tau_rtol : float
+        Largest relative change of the τ estimate between checks for the
+        chain to count as converged (emcee's tutorial uses 0.01; 0.05 is
+        within the estimator's own noise at 50 τ).
+
+    Returns
+    -------
+    list of Posterior
+    """
+    if rng is None:
+        raise EffortError("sample_posteriors needs an explicit rng (numpy Generator or seed)")
+    rng = np.random.default_rng(rng)
+    datasets = list(datasets)
+    if not datasets:
+        return []
+    batch = Batch(datasets, free_ends=free_ends)
+    fits = fit_logistic_many([batch.dataset(g) for g in range(batch.n_groups)])
+    starts, balls, start3 = [], [], []
+    for fit in fits:
+        # start inside the box even when the LSQ optimum sits on a range edge
+        b0 = float(np.clip(fit.b, TIME_RANGE[0] + 0.02, TIME_RANGE[1] - 0.02))
+        x00 = float(np.clip(fit.x0, WEIGHT_RANGE[0] + 0.005, WEIGHT_RANGE[1] - 0.005))
+        lns0 = float(np.clip(np.log(max(fit.sigma, 1.5e-4)), LOG_SIGMA_RANGE[0] + 0.1, LOG_SIGMA_RANGE[1] - 0.1))
+        starts.append((b0, x00))
+        start3.append(np.array([b0, x00, lns0]))
+        # a small ball: a tenth of the linearised posterior width, so that
+        # walkers need not first contract (noise-free renders give widths of 1e-5)
+        balls.append((min(0.01, 0.1 * fit.sd[0]), min(0.002, 0.1 * fit.sd[1])))
+    chains = run_groups(batch, starts, balls, rng, nwalkers=nwalkers, block=block, max_steps=max_steps,
+                        tau_rtol=tau_rtol)
+    out = []
+    for g, ch in enumerate(chains):
+        if not ch.converged:
+            log.info("emcee did not converge in %d steps (tau = %s)", ch.steps, np.round(ch.tau, 1))
+        bx = ch.samples()
+        lns = batch.draw_log_sigma(g, bx, rng)
+        out.append(Posterior(
+            samples=np.column_stack([bx, lns]),
+            tau=np.asarray(ch.tau, dtype=float),
+            acceptance=ch.acceptance,
+            converged=ch.converged,
+            steps=ch.steps,
+            start=start3[g],
+        ))
+    return out
+
+
 def sample_posterior(
     tau,
     s,
@@ -134,11 +217,11 @@ def sample_posterior(
     groups=None,
     free_ends: bool = True,
     nwalkers: int = 16,
-    block: int = 100,
+    block: int = 50,
     max_steps: int = 6000,
     tau_rtol: float = 0.05,
 ) -> Posterior:
-    """Sample the posterior of (b, x0, ln σ) with emcee.
+    """Sample the posterior of (b, x0, ln σ) of one movement or one pooled set.
 
     Parameters
     ----------
@@ -148,25 +231,12 @@ def sample_posterior(
     weight : (N,) array_like, optional
         Per-sample confidence in (0, 1].
     rng : numpy.random.Generator or int
-        Source of every random draw (walker ball and emcee's moves); required
-        so runs are reproducible.
+        Source of every random draw; required.
     groups : (N,) array_like of int, optional
         Movement index of each sample when several are pooled (default: one
         movement).
-    free_ends : bool
-        Give each movement a free offset and end scale, marginalised
-        analytically (see :func:`log_probability`); False pins s(0) = 0 and
-        s(1) = 1 to the observed start and end.
-    nwalkers : int
-        Ensemble size (≥ 2 × 3 dimensions).
-    block : int
-        Steps between convergence checks.
-    max_steps : int
-        Give up (``converged = False``) after this many steps.
-    tau_rtol : float
-        Largest relative change of the τ estimate between checks for the
-        chain to count as converged (emcee's tutorial uses 0.01; 0.05 is
-        within the estimator's own noise at 50 τ and halves the run time).
+    free_ends, nwalkers, block, max_steps, tau_rtol
+        As for :func:`sample_posteriors`.
 
     Returns
     -------
@@ -174,61 +244,9 @@ def sample_posterior(
     """
     if rng is None:
         raise EffortError("sample_posterior needs an explicit rng (numpy Generator or seed)")
-    rng = np.random.default_rng(rng)
     tau = np.asarray(tau, dtype=float)
-    s = np.asarray(s, dtype=float)
-    w = np.ones_like(tau) if weight is None else np.asarray(weight, dtype=float)
-    fit = fit_logistic(tau, s, w)
-    lns0 = float(np.clip(np.log(max(fit.sigma, 1.5e-4)), LOG_SIGMA_RANGE[0] + 0.1, LOG_SIGMA_RANGE[1] - 0.1))
-    # start inside the box even when the LSQ optimum sits on a range edge
-    b0 = float(np.clip(fit.b, TIME_RANGE[0] + 0.02, TIME_RANGE[1] - 0.02))
-    x00 = float(np.clip(fit.x0, WEIGHT_RANGE[0] + 0.005, WEIGHT_RANGE[1] - 0.005))
-    start = np.array([b0, x00, lns0])
-    # a small ball: a tenth of the linearised posterior width, so that
-    # walkers need not first contract (noise-free renders give widths of 1e-5)
-    ball = np.array([min(0.01, 0.1 * fit.sd[0]), min(0.002, 0.1 * fit.sd[1]), 0.05])
-    p0 = start + ball * rng.standard_normal((nwalkers, 3))
-    p0[:, 0] = np.clip(p0[:, 0], TIME_RANGE[0] + 1e-3, TIME_RANGE[1] - 1e-3)
-    p0[:, 1] = np.clip(p0[:, 1], WEIGHT_RANGE[0] + 1e-4, WEIGHT_RANGE[1] - 1e-4)
-    p0[:, 2] = np.clip(p0[:, 2], LOG_SIGMA_RANGE[0] + 1e-3, LOG_SIGMA_RANGE[1] - 1e-3)
-
-    onehot = None
-    if free_ends:
-        g = np.zeros(tau.size, dtype=int) if groups is None else np.asarray(groups)
-        if g.shape != tau.shape:
-            raise EffortError(f"groups must label each of the {tau.size} samples, got shape {g.shape}")
-        onehot = (g[:, None] == np.unique(g)[None, :]).astype(float)
-    sampler = emcee.EnsembleSampler(
-        nwalkers, 3, log_probability, args=(tau, s, w, onehot), vectorize=True,
-        moves=emcee.moves.DEMove(),
-    )
-    sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
-    state = p0
-    old_tau = np.inf
-    converged = False
-    steps = 0
-    while steps < max_steps:
-        state = sampler.run_mcmc(state, block, progress=False)
-        steps += block
-        act = sampler.get_autocorr_time(tol=0)
-        if np.all(np.isfinite(act)) and steps >= N_TAU * act.max() and np.all(np.abs(old_tau - act) / act < tau_rtol):
-            converged = True
-            break
-        old_tau = act
-    act = sampler.get_autocorr_time(tol=0)
-    if not converged:
-        log.info("emcee did not converge in %d steps (tau = %s)", steps, np.round(act, 1))
-    finite = np.isfinite(act) & (act > 0)
-    tmax = float(act[finite].max()) if finite.any() else float(steps) / N_TAU
-    tmin = float(act[finite].min()) if finite.any() else 1.0
-    burn = min(int(2 * tmax), steps // 2)
-    thin = max(1, int(0.5 * tmin))
-    samples = sampler.get_chain(discard=burn, thin=thin, flat=True)
-    return Posterior(
-        samples=samples,
-        tau=np.asarray(act, dtype=float),
-        acceptance=float(np.mean(sampler.acceptance_fraction)),
-        converged=converged,
-        steps=steps,
-        start=start,
-    )
+    if groups is not None and np.shape(groups) != tau.shape:
+        raise EffortError(f"groups must label each of the {tau.size} samples, got shape {np.shape(groups)}")
+    (post,) = sample_posteriors([(tau, s, weight, groups)], rng, free_ends=free_ends, nwalkers=nwalkers,
+                                block=block, max_steps=max_steps, tau_rtol=tau_rtol)
+    return post

@@ -11,7 +11,7 @@ from types import MappingProxyType
 
 from ..notation.model import Effort
 
-__all__ = ["Preset", "PRESETS"]
+__all__ = ["PRESETS", "Preset"]
 
 
 @dataclass(frozen=True)

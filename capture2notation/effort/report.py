@@ -1,6 +1,6 @@
 """Writing ``effort.json`` and the Effort plots (atomically).
 
-Plots (matplotlib, Agg backend, no display needed):
+Plots (matplotlib ``Figure`` objects, no pyplot and no display needed):
 
 * ``effort_progress.png`` — each movement's observed progress s(τ) with the
   posterior median curve and its 90 % band;
@@ -30,13 +30,11 @@ POOLED_PNG = "effort_pooled.png"
 MAX_PANELS = 30
 
 
-def _pyplot():
-    import matplotlib
+def _figure(**kw):
+    """A matplotlib Figure with the Agg canvas — no pyplot, so no global figure state to leak."""
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return Figure(**kw)
 
 
 def write_effort(result: EffortResult, outdir, plots: bool = True, rng=0) -> dict:
@@ -76,14 +74,20 @@ def _band(samples: np.ndarray, grid: np.ndarray, rng, n: int = 200) -> np.ndarra
 
 def plot_progress(result: EffortResult, path, rng=0) -> Path:
     """Observed progress of each movement with its posterior band; returns `path`."""
-    plt = _pyplot()
+    from matplotlib.ticker import FixedLocator
+
     rng = np.random.default_rng(rng)
     moves = result.movements[:MAX_PANELS]
     n = max(len(moves), 1)
     cols = min(n, 5)
     rows = math.ceil(n / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(2.6 * cols, 2.3 * rows), squeeze=False, sharex=True, sharey=True)
+    fig = _figure(figsize=(2.6 * cols, 2.3 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False, sharex=True, sharey=True)
     grid = np.linspace(0.0, 1.0, 101)
+    # fixed ticks: the automatic locators re-run on every panel, which
+    # dominated the drawing time of a phrase's many small panels
+    axes.flat[0].xaxis.set_major_locator(FixedLocator([0.0, 0.5, 1.0]))
+    axes.flat[0].yaxis.set_major_locator(FixedLocator([0.0, 0.5, 1.0]))
     for ax, m in zip(axes.flat, moves):
         lo, med, hi = _band(m.posterior.samples, grid, rng)
         ax.fill_between(grid, lo, hi, color="tab:blue", alpha=0.3, lw=0, label="90 % band")
@@ -104,19 +108,22 @@ def plot_progress(result: EffortResult, path, rng=0) -> Path:
     fig.suptitle(f"Progress s(τ) per movement{extra}", fontsize=9)
     fig.supxlabel("normalised time τ", fontsize=8)
     fig.supylabel("progress s", fontsize=8)
-    fig.tight_layout()
+    # fixed margins instead of tight_layout (which measures every tick label)
+    fig.subplots_adjust(left=0.35 / (2.6 * cols) + 0.04, right=0.98, bottom=0.45 / (2.3 * rows) + 0.03,
+                        top=1.0 - 0.75 / (2.3 * rows), wspace=0.12, hspace=0.55)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
     return Path(path)
 
 
 def plot_pooled(result: EffortResult, path) -> Path:
     """Corner-style plot of the pooled (b, x0) posteriors; returns `path`."""
-    plt = _pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(6.0, 5.5))
+    from matplotlib import rcParams
+
+    fig = _figure(figsize=(6.0, 5.5))
+    axes = fig.subplots(2, 2)
     groups = ([("phrase", result.pooled)] if result.pooled is not None else []) + sorted(result.parts.items())
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (label, pooled) in enumerate(groups):
         smp = pooled.posterior.samples
         c = colours[k % len(colours)]
@@ -141,8 +148,7 @@ def plot_pooled(result: EffortResult, path) -> Path:
     if groups:
         axes[0, 0].legend(fontsize=6)
     fig.suptitle("Pooled Effort posterior", fontsize=10)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.11, right=0.97, bottom=0.09, top=0.92, wspace=0.3, hspace=0.35)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
     return Path(path)

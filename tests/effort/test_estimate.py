@@ -8,7 +8,7 @@ import pytest
 from click.testing import CliRunner
 
 from capture2notation.body import joint_index
-from capture2notation.effort import estimate_effort, write_effort
+from capture2notation.effort import estimate_effort, progress, write_effort
 from capture2notation.effort.testing import arc_motion, random_arm_score
 from capture2notation.errors import EffortError
 from capture2notation.notation import Score, Symbol, write
@@ -70,6 +70,22 @@ def test_results_do_not_depend_on_worker_count():
         np.testing.assert_array_equal(a.posterior.samples, b.posterior.samples)
     assert not any(m.posterior.converged for m in one.movements)  # 100 steps: honestly unconverged
     assert json.dumps(one.to_dict()) == json.dumps(two.to_dict())
+
+
+def test_chunked_sampling_keeps_order_and_does_not_depend_on_workers(monkeypatch):
+    from capture2notation.effort import estimate as est
+
+    monkeypatch.setattr(est, "CHUNK", 2)  # 4 movements + pooled sets: several chunks
+    score = random_arm_score(np.random.default_rng(3), 4, tempo=90, effort=Effort(-3.2, 0.45, 1.0))
+    joints = arc_motion(score, 25.0) + 0.003 * np.random.default_rng(6).standard_normal((1, 1, 1))
+    kw = {"block": 50, "max_steps": 150}
+    one = estimate_effort(joints, None, 25.0, score, rng=2, sampler_kw=kw)
+    two = estimate_effort(joints, None, 25.0, score, rng=2, workers=2, sampler_kw=kw)
+    assert json.dumps(one.to_dict()) == json.dumps(two.to_dict())
+    # each movement's posterior belongs to its own curve (order kept through the chunks)
+    for m in one.movements:
+        med = np.median(m.curve.s[np.abs(m.curve.tau - 0.5) < 0.1])
+        assert abs(med - progress(0.5, m.posterior.summary(0)["median"], m.posterior.summary(1)["median"])) < 0.05
 
 
 def test_unmeasurable_movements_are_skipped_with_a_reason():

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from capture2notation.effort.fit import fit_logistic, fit_space
+from capture2notation.effort.fit import fit_logistic, fit_logistic_many, fit_space
 from capture2notation.effort.model import progress
 from capture2notation.errors import EffortError
 
@@ -29,6 +29,23 @@ def test_noisy_fit_sigma_matches_the_noise():
     assert f.sigma == pytest.approx(0.02, rel=0.1)
     assert f.b == pytest.approx(-2.8, abs=0.15)
     assert f.x0 == pytest.approx(0.5, abs=0.01)
+
+
+def test_many_fits_at_once_equal_one_at_a_time():
+    rng = np.random.default_rng(11)
+    sets = []
+    for n, sigma in ((12, 0.0), (29, 0.01), (45, 0.03), (20, 0.003), (33, 0.05)):
+        tau = np.sort(rng.uniform(0.01, 0.99, n))
+        b, x0 = rng.uniform(-4.8, -1.6), rng.uniform(0.2, 0.9)
+        sets.append((tau, progress(tau, b, x0) + sigma * rng.standard_normal(n), rng.uniform(0.5, 1.0, n)))
+    for many, (tau, s, w) in zip(fit_logistic_many(sets), sets):
+        one = fit_logistic(tau, s, w)
+        assert many.cost <= one.cost * (1 + 1e-6) + 1e-20
+        assert many.b == pytest.approx(one.b, abs=2e-3)
+        assert many.x0 == pytest.approx(one.x0, abs=5e-4)
+        assert many.sigma == pytest.approx(one.sigma, rel=1e-3, abs=1e-9)
+        assert many.sd == pytest.approx(one.sd, rel=0.02)
+    assert fit_logistic_many([]) == []
 
 
 @pytest.mark.parametrize("space", [0.0, 0.3, 0.5, 1.0])

@@ -8,6 +8,7 @@ from capture2notation.effort.posterior import (
     LOG_SIGMA_RANGE,
     log_probability,
     sample_posterior,
+    sample_posteriors,
 )
 from capture2notation.errors import EffortError
 
@@ -112,3 +113,19 @@ def test_pooled_groups_share_b_and_x0_but_not_the_ends():
     pinned = sample_posterior(np.concatenate(taus), np.concatenate(ss), rng=rng, free_ends=False)
     # pinning c = 0, k = 1 on shifted, mis-scaled movements inflates the noise estimate
     assert np.median(pinned.samples[:, 2]) > np.median(post.samples[:, 2]) + 0.5
+
+
+def test_many_posteriors_at_once_each_cover_their_truth():
+    rng = np.random.default_rng(21)
+    truths = [(-2.2, 0.62), (-4.1, 0.33), (-3.0, 0.5), (-2.6, 0.75)]
+    data = [(TAU, progress(TAU, b, x0) + 0.01 * rng.standard_normal(TAU.size), None, None) for b, x0 in truths]
+    posts = sample_posteriors(data, rng=5)
+    again = sample_posteriors(data, rng=5)
+    assert len(posts) == len(truths)
+    for (b, x0), post, twin in zip(truths, posts, again):
+        np.testing.assert_array_equal(post.samples, twin.samples)
+        assert post.converged and post.samples.shape[1] == 3
+        assert post.summary(0)["median"] == pytest.approx(b, abs=0.3)
+        assert post.summary(1)["median"] == pytest.approx(x0, abs=0.04)
+        assert np.exp(np.median(post.samples[:, 2])) == pytest.approx(0.01, rel=0.5)
+    assert sample_posteriors([], rng=0) == []

@@ -1,0 +1,310 @@
+"""Vectorised marginal likelihood of (b, x0) for a batch of independent posteriors.
+
+The model of :mod:`.posterior`: ``s_i = c_g + k_g·progress(τ_i; b, x0) + ε_i``,
+``ε_i ~ N(0, σ²/w_i)``, one (b, x0, σ) per *posterior* and one free offset
+``c_g`` and end scale ``k_g`` per *movement* g of it (flat priors), or
+``c = 0, k = 1`` when the ends are pinned.  The nuisance parameters are
+integrated out analytically, so the sampler moves in two dimensions only:
+
+* (c_g, k_g): a Gaussian integral — χ² at their best values plus
+  ½·log det of each movement's 2×2 normal equations;
+* ln σ, uniform on :data:`LOG_SIGMA_RANGE`: with ``a = dof/2``,
+  ``∫ σ^(−2a) exp(−χ²/2σ²) d ln σ ∝ χ²^(−a) [P(a, χ²/2σ_min²) − P(a, χ²/2σ_max²)]``
+  (P the regularised lower incomplete gamma function), exact including the
+  prior's truncation, which matters for noise-free renders.
+
+:class:`Batch` holds the data of many posteriors ("groups") flattened once,
+so one call evaluates every walker of every group in a few numpy passes:
+the rows of θ are group-major with the same number of walkers per group.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import special
+
+from ..errors import EffortError
+from .model import TIME_RANGE, WEIGHT_RANGE
+
+__all__ = ["LOG_SIGMA_RANGE", "Batch", "log_gammainc"]
+
+#: Uniform prior bounds of ln σ (σ from 1e-4 to 0.5 in units of progress).
+LOG_SIGMA_RANGE = (np.log(1e-4), np.log(0.5))
+#: Below this a regularised incomplete gamma value is taken from its series.
+_TINY = 1e-280
+#: 1 / (2 σ²) at the small-σ and large-σ ends of the prior.
+_HALF_INV_VAR = 0.5 * np.exp(-2.0 * np.asarray(LOG_SIGMA_RANGE))
+
+
+def log_gammainc(a, x):
+    """log P(a, x), the regularised lower incomplete gamma function, without underflow.
+
+    Parameters
+    ----------
+    a, x : array_like
+        Shape (> 0) and argument (≥ 0), broadcast together.
+
+    Returns
+    -------
+    ndarray
+        ``log P(a, x)``; where P underflows (x far below a) the series
+        ``P = x^a e^−x / Γ(a+1) · Σ_k x^k / ((a+1)…(a+k))`` is summed in logs.
+    """
+    a, x = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(x, dtype=float))
+    p = special.gammainc(a, x)
+    out = np.empty(a.shape)
+    big = p > _TINY
+    out[big] = np.log(p[big])
+    if not big.all():
+        aa, xx = a[~big], x[~big]
+        with np.errstate(divide="ignore"):
+            lead = aa * np.log(xx) - xx - special.gammaln(aa + 1.0)
+        # underflow needs x < a, so the terms shrink at least geometrically
+        term = np.ones_like(xx)
+        total = np.ones_like(xx)
+        for k in range(1, 80):
+            term = term * xx / (aa + k)
+            total += term
+        out[~big] = lead + np.log(total)
+    return out
+
+
+def _log_sigma_integral(chi2: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """log ∫ σ^(−2a) exp(−χ²/2σ²) d ln σ over LOG_SIGMA_RANGE, up to a per-`a` constant."""
+    u0 = chi2 * _HALF_INV_VAR[0]  # the small-σ end
+    u1 = chi2 * _HALF_INV_VAR[1]
+    p0, p1 = special.gammainc(a, u0), special.gammainc(a, u1)
+    if np.all(p0 > _TINY) and np.all(p1 < 0.5):  # the usual case: σ well inside the prior
+        return -a * np.log(chi2) + np.log(p0 - p1)
+    lp0 = log_gammainc(a, u0)
+    # P(a, u1) / P(a, u0) <= 1; when both are near 1 use the upper tails instead
+    q1, q0 = special.gammaincc(a, u1), special.gammaincc(a, u0)
+    near_one = q1 < 0.5
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        ratio = np.exp(log_gammainc(a, u1) - lp0)
+        diff_log = np.where(near_one, np.log(np.maximum(q1 - q0, 0.0)), lp0 + np.log1p(-np.minimum(ratio, 1.0)))
+    return -a * np.log(chi2) + diff_log
+
+
+class Batch:
+    """Data of G independent posteriors, flattened for vectorised evaluation.
+
+    Parameters
+    ----------
+    datasets : sequence of (tau, s, weight, movement) tuples
+        Per posterior: (N,) normalised time in (0, 1), progress, confidence
+        (> 0) and the movement index of each sample (None: one movement).
+    free_ends : bool
+        Marginalise a free offset and end scale per movement; False pins
+        ``c = 0, k = 1``.
+
+    Attributes
+    ----------
+    n_groups : int
+    dof : (G,) ndarray
+        Residual degrees of freedom: samples minus 2 per movement when the
+        ends are free.
+    """
+
+    def __init__(self, datasets, free_ends: bool = True):
+        taus, ss, ws, segs, grp = [], [], [], [], []
+        seg_group, n_seg = [], 0
+        for g, (tau, s, w, mov) in enumerate(datasets):
+            tau = np.asarray(tau, dtype=float)
+            s = np.asarray(s, dtype=float)
+            w = np.ones_like(tau) if w is None else np.asarray(w, dtype=float)
+            mov = np.zeros(tau.size, dtype=int) if mov is None else np.asarray(mov)
+            if not (tau.ndim == 1 and tau.shape == s.shape == w.shape == mov.shape):
+                raise EffortError(
+                    f"posterior {g}: tau, s, weight and movement labels must be equal 1-D arrays, got "
+                    f"{tau.shape}, {s.shape}, {w.shape}, {mov.shape}"
+                )
+            if tau.size < 3 or np.any((tau <= 0) | (tau >= 1)) or not np.all(np.isfinite(s)) or np.any(w <= 0):
+                raise EffortError(
+                    f"posterior {g}: need >= 3 samples with tau in (0, 1), finite progress and weight > 0"
+                )
+            _, local = np.unique(mov, return_inverse=True)
+            distinct = [np.unique(tau[local == j]).size for j in range(local.max() + 1)]
+            if min(distinct) < 3:
+                raise EffortError(f"posterior {g}: each movement needs samples at >= 3 distinct times, got {distinct}")
+            taus.append(tau)
+            ss.append(s)
+            ws.append(w)
+            segs.append(n_seg + local)
+            grp.append(np.full(tau.size, g))
+            seg_group += [g] * (local.max() + 1)
+            n_seg += local.max() + 1
+        if not taus:
+            raise EffortError("a batch needs at least one posterior")
+        self.n_groups = len(taus)
+        self.free_ends = bool(free_ends)
+        self._logtau = np.log(np.concatenate(taus))
+        self._s = np.concatenate(ss)
+        self._w = np.concatenate(ws)
+        self._seg = np.concatenate(segs)
+        self._grp = np.concatenate(grp)
+        self._seg_group = np.asarray(seg_group)
+        self._samples_of = [np.flatnonzero(self._grp == g) for g in range(self.n_groups)]
+        self._segs_of = [np.flatnonzero(self._seg_group == g) for g in range(self.n_groups)]
+        ws_ = self._w * self._s
+        self._s0 = np.bincount(self._seg, self._w, n_seg)
+        self._ss = np.bincount(self._seg, ws_, n_seg)
+        self._sss = np.bincount(self._seg, ws_ * self._s, n_seg)
+        n = np.bincount(self._grp, minlength=self.n_groups).astype(float)
+        nseg = np.bincount(self._seg_group, minlength=self.n_groups)
+        self.dof = n - 2.0 * nseg if self.free_ends else n
+        if np.any(self.dof < 1):
+            raise EffortError(f"posteriors {np.flatnonzero(self.dof < 1).tolist()} have fewer samples than free ends")
+        self._layouts: dict = {}
+
+    def dataset(self, g: int):
+        """(tau, s, weight) of posterior `g`, each (N_g,)."""
+        i = self._samples_of[g]
+        return np.exp(self._logtau[i]), self._s[i], self._w[i]
+
+    def _layout(self, groups: tuple, k: int, cache: bool = True) -> dict:
+        """Index arrays pairing each of the k walkers of `groups` with its group's samples."""
+        key = (groups, k)
+        if not cache or key not in self._layouts:
+            rows, cols, combo_row, combo_seg, keys = [], [], [], [], []
+            r0 = c0 = 0
+            for g in groups:
+                idx, sg = self._samples_of[g], self._segs_of[g]
+                r = r0 + np.arange(k)
+                rows.append(np.repeat(r, idx.size))
+                cols.append(np.tile(idx, k))
+                # one "combo" per (walker, movement): where the segment sums go
+                local = np.searchsorted(sg, self._seg[idx])
+                keys.append(c0 + (np.arange(k)[:, None] * sg.size + local[None, :]).ravel())
+                combo_row.append(np.repeat(r, sg.size))
+                combo_seg.append(np.tile(sg, k))
+                r0 += k
+                c0 += k * sg.size
+            rows, cols = np.concatenate(rows), np.concatenate(cols)
+            lay = {
+                "rows": rows,
+                "logtau": self._logtau[cols],
+                "w": self._w[cols],
+                "ws": self._w[cols] * self._s[cols],
+                "key": np.concatenate(keys),
+                "n_combo": c0,
+                "combo_row": np.concatenate(combo_row),
+                "combo_seg": np.concatenate(combo_seg),
+                "a": np.repeat(0.5 * self.dof[list(groups)], k),
+            }
+            if not cache:
+                return lay
+            self._layouts[key] = lay
+            if len(self._layouts) > 64:  # active sets shrink as groups converge
+                self._layouts.pop(next(iter(self._layouts)))
+        return self._layouts[key]
+
+    def chi2(self, theta, groups=None, cache: bool = True):
+        """Minimum χ² over the free ends, and Σ log det of their normal equations.
+
+        Parameters
+        ----------
+        theta : (len(groups)·k, 2) ndarray
+            (b, x0) rows, group-major, k rows per group, inside the prior box.
+        groups : sequence of int, optional
+            The groups the rows belong to (default: all, in order).
+        cache : bool
+            Keep the index arrays for further calls with the same layout
+            (the sampler's case); False for one-off evaluations.
+
+        Returns
+        -------
+        chi2, logdet : (rows,) ndarray
+        """
+        groups = tuple(range(self.n_groups)) if groups is None else tuple(int(g) for g in groups)
+        theta = np.asarray(theta, dtype=float)
+        if theta.ndim != 2 or theta.shape[1] != 2 or theta.shape[0] % len(groups):
+            raise EffortError(f"theta must be ({len(groups)}·k, 2) for {len(groups)} groups, got {theta.shape}")
+        k = theta.shape[0] // len(groups)
+        lay = self._layout(groups, k, cache)
+        b, lnx = theta[:, 0], np.log(theta[:, 1])
+        # progress() without its checks: s = (1 + x0^−b) / (1 + exp(b (ln τ − ln x0)))
+        amp = 1.0 + np.exp(-b * lnx)
+        br = b[lay["rows"]]
+        m = amp[lay["rows"]] / (1.0 + np.exp(br * lay["logtau"] - (b * lnx)[lay["rows"]]))
+        wm = lay["w"] * m
+        n_c, key = lay["n_combo"], lay["key"]
+        s_m = np.bincount(key, wm, n_c)
+        s_mm = np.bincount(key, wm * m, n_c)
+        s_sm = np.bincount(key, lay["ws"] * m, n_c)
+        seg = lay["combo_seg"]
+        s0, s_s, s_ss = self._s0[seg], self._ss[seg], self._sss[seg]
+        rows = theta.shape[0]
+        if self.free_ends:
+            det = s0 * s_mm - s_m * s_m
+            # det <= 0 only by rounding on a flat model: NaN, rejected by log_marginal
+            with np.errstate(invalid="ignore", divide="ignore"):
+                fit = (s_mm * s_s * s_s - 2.0 * s_m * s_s * s_sm + s0 * s_sm * s_sm) / det
+                logdet = np.bincount(lay["combo_row"], np.log(det), rows)
+            chi2 = np.bincount(lay["combo_row"], s_ss - fit, rows)
+        else:
+            chi2 = np.bincount(lay["combo_row"], s_ss - 2.0 * s_sm + s_mm, rows)
+            logdet = np.zeros(rows)
+        # rounding can leave a perfect fit's χ² at or just below zero
+        return np.maximum(chi2, 1e-300), logdet
+
+    def log_marginal(self, theta, groups=None) -> np.ndarray:
+        """log p(b, x0 | data) up to a per-group constant, −inf outside the prior box.
+
+        Parameters
+        ----------
+        theta : (len(groups)·k, 2) ndarray
+            Group-major (b, x0) rows, k per group.
+        groups : sequence of int, optional
+            Default: all groups, in order.
+
+        Returns
+        -------
+        (rows,) ndarray
+        """
+        theta = np.asarray(theta, dtype=float)
+        groups = tuple(range(self.n_groups)) if groups is None else tuple(int(g) for g in groups)
+        if theta.ndim != 2 or theta.shape[1] != 2 or theta.shape[0] % len(groups):
+            raise EffortError(f"theta must be ({len(groups)}·k, 2) for {len(groups)} groups, got {theta.shape}")
+        inside = (
+            (theta[:, 0] > TIME_RANGE[0]) & (theta[:, 0] < TIME_RANGE[1])
+            & (theta[:, 1] > WEIGHT_RANGE[0]) & (theta[:, 1] < WEIGHT_RANGE[1])
+        )
+        safe = theta
+        if not inside.all():
+            # evaluate every row (keeps the layout regular); outside rows are
+            # moved into the box first and discarded after
+            safe = np.column_stack([
+                np.clip(theta[:, 0], TIME_RANGE[0] + 1e-6, TIME_RANGE[1] - 1e-6),
+                np.clip(theta[:, 1], WEIGHT_RANGE[0] + 1e-6, WEIGHT_RANGE[1] - 1e-6),
+            ])
+        chi2, logdet = self.chi2(safe, groups)
+        a = self._layout(groups, theta.shape[0] // len(groups))["a"]
+        with np.errstate(invalid="ignore"):
+            out = _log_sigma_integral(chi2, a) - 0.5 * logdet
+        # a degenerate model (det <= 0 by rounding) is rejected, never accepted
+        out[~inside | np.isnan(out)] = -np.inf
+        return out
+
+    def draw_log_sigma(self, g: int, theta, rng: np.random.Generator) -> np.ndarray:
+        """Exact draws of ln σ given each (b, x0) row of posterior `g`: (M,) from (M, 2).
+
+        Given (b, x0), ``u = χ²/2σ²`` is Gamma(a, 1) truncated to the prior's
+        range of σ; it is drawn by inverting the truncated CDF.
+        """
+        theta = np.asarray(theta, dtype=float)
+        # in row chunks of about a million (walker, sample) pairs
+        step = max(1, (1 << 20) // self._samples_of[g].size)
+        chi2 = np.concatenate([self.chi2(theta[i:i + step], (g,), cache=False)[0]
+                               for i in range(0, theta.shape[0], step)])
+        a = 0.5 * self.dof[g]
+        lo, hi = np.exp(2.0 * np.asarray(LOG_SIGMA_RANGE))
+        u0, u1 = chi2 / (2.0 * lo), chi2 / (2.0 * hi)
+        p0, p1 = special.gammainc(a, u0), special.gammainc(a, u1)
+        v = rng.uniform(size=chi2.size)
+        u = special.gammaincinv(a, p1 + v * (p0 - p1))
+        # where P(a, u0) underflows the density is ∝ u^(a−1) on (0, u0]
+        tiny = p0 < _TINY
+        u[tiny] = u0[tiny] * v[tiny] ** (1.0 / a)
+        u = np.clip(u, u1, u0)
+        return 0.5 * np.log(chi2 / (2.0 * u))
