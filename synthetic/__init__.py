@@ -5,7 +5,11 @@
 * :mod:`synthetic.motion` — :class:`Motion`, key framing and the motion
   algebra of Cachola (1986) ch. 4;
 * :mod:`synthetic.interpret` — :func:`interpret` a :class:`Score` into a
-  :class:`Motion`;
+  :class:`Motion`, from :mod:`synthetic.limbs` (arms and legs),
+  :mod:`synthetic.trunk` (head and chest), :mod:`synthetic.supports` (feet
+  and weight), :mod:`synthetic.extremes` (paths within the joint limits)
+  and :mod:`synthetic.rotations`; :mod:`synthetic.reach` reports what the
+  joint limits forbid (:class:`UnreachableWarning`);
 * :mod:`synthetic.random_scores` — random valid, renderable scores;
 * :mod:`synthetic.phrases` — built-in phrases (Figure 7, third port de bras,
   a leg phrase);

@@ -13,16 +13,23 @@ exactly.  Guarantees (each is checked by ``tests/synthetic``):
 * reachable: every gesture direction is within the joint extremes (no arm
   through the torso behind-low, no leg higher than the hip allows, no
   gesture leg down at place low where it would stand on the floor; the head
-  within 40° of the chest).  This is *verified*: the draw is interpreted and
+  within the neck's range of the chest, moving whenever the chest moves).
+  This is *verified*: the draw is interpreted at :data:`VERIFY_FPS` and
   redrawn (same generator stream) until no
-  :class:`~synthetic.interpret.UnreachableWarning` is raised, so quantising
-  the interpreted joints gives back exactly the symbols.  No arm or head
-  symbol ends while the chest moves, and leg gestures never end while the
-  weight shifts, so the check holds at any frame rate.
+  :class:`~synthetic.interpret.UnreachableWarning` is raised (end poses,
+  paths within the extremes, holds, supports), so quantising the
+  interpreted joints gives back exactly the symbols.  No arm symbol ends
+  while the chest moves, and leg gestures never end while the weight
+  shifts, so the check holds at other frame rates too (property-tested at
+  10–50 fps).
 
 Supports follow a dancer's logic: both feet (plié, middle, relevé), a
 weight transfer onto one foot followed by gestures of the free leg and a
 closing onto both feet, or a step (``right_support forward middle`` …).
+A change of support level takes at least :data:`LEVEL_CHANGE_S` seconds (a
+heel moving faster does not read as supporting), and the foot that has
+just landed from a step or a closing keeps the weight for the next symbol
+(a foot lifted again on its landing frame never reads as supporting).
 """
 
 from __future__ import annotations
@@ -66,7 +73,8 @@ def _leg_targets() -> tuple:
     """(direction, level, bend) for the right leg, within the hip's extremes."""
     out = []
     for d in ("forward", "right_forward", "left_forward"):
-        out += [(d, "high", b) for b in (0, 1)] + [(d, lv, b) for lv in ("middle", "low") for b in (0, 1, 2)]
+        # High legs straight only: a bent knee lifts the thigh past the hip's 135°.
+        out += [(d, "high", 0)] + [(d, lv, b) for lv in ("middle", "low") for b in (0, 1, 2)]
     for d in ("right", "right_back"):
         out += [(d, lv, b) for lv in ("middle", "low") for b in (0, 1)]
     out += [("back", "middle", 0), ("back", "low", 0), ("back", "low", 1)]
@@ -81,6 +89,10 @@ LEG_TARGETS: tuple = _leg_targets()
 HEAD_TARGETS: tuple = (("place", "high", 0),) + tuple((d, "high", 0) for d in _SECTORS) + (("forward", "middle", 0),)
 CHEST_TARGETS: tuple = HEAD_TARGETS
 _DURATIONS = tuple(Fraction(n, 4) for n in (2, 3, 4, 6, 8))
+#: Frame rate at which a draw is verified (support speeds need a real rate).
+VERIFY_FPS = 25.0
+#: Shortest change of support level, seconds.
+LEVEL_CHANGE_S = 0.7
 _GAPS = tuple(Fraction(n, 4) for n in (0, 0, 1, 2, 4))
 
 
@@ -120,43 +132,65 @@ def _gesture_track(rng, part, targets, t0, t1, with_bend=True, chest=()):
         t += dur
 
 
-def _head_track(rng, chest, t1):
-    """Head symbols that the neck can reach from wherever the chest is then.
+def _head_ok(target, chest_dir) -> bool:
+    """Whether the neck can hold head `target` over a chest pointing `chest_dir`.
 
-    The head's direction is in the body frame, so a tilted chest leaves the
-    neck less range: each head target lies within 40° of the chest's
-    direction at the head's arrival, and no head movement ends while the
-    chest is moving.
+    Within 40° of the chest (the neck bends 45° sideways), or a bow of the
+    head to the horizontal over an upright chest (the neck bows 90°).
     """
     from capture2notation.notation.directions import canonical_vector
 
-    def chest_dir(beat):
-        if _moving(chest, beat):
-            return None
-        d = np.array([0.0, 0.0, 1.0])
-        for c in chest:
-            if c.end <= beat:
-                d = canonical_vector(c.direction, c.level)
-        return d
+    h = canonical_vector(target[0], target[1])
+    if h @ chest_dir >= np.cos(np.radians(40)):
+        return True
+    return target[:2] == ("forward", "middle") and chest_dir[2] > 1 - 1e-9
 
-    out, t, last = [], Fraction(0), None
-    while True:
-        t += _GAPS[int(rng.integers(len(_GAPS)))]
-        dur = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
-        if t + dur > t1:
-            return out
-        c = chest_dir(t + dur)
-        if c is None:
-            t += dur
-            continue
-        ok = [x for x in HEAD_TARGETS if x != last and canonical_vector(x[0], x[1]) @ c >= np.cos(np.radians(40))]
+
+def _head_track(rng, chest, t1):
+    """Head symbols that the neck can hold whatever the chest does.
+
+    The head's direction is in the body frame, so a tilted chest leaves the
+    neck less range.  The head moves with every chest movement (same span),
+    to a target the neck can hold over the chest's new direction, so no head
+    hold is ever carried off by the chest; between chest movements it moves
+    freely within the neck's range.
+    """
+    from capture2notation.notation.directions import canonical_vector
+
+    out, last = [], None
+    chest = sorted(chest, key=lambda c: c.start)
+    up = np.array([0.0, 0.0, 1.0])
+    # Gaps between chest movements, each with the chest's direction then.
+    spans, t, c_dir = [], Fraction(0), up
+    for c in chest:
+        spans.append((t, c.start, c_dir, None))
+        c_dir = canonical_vector(c.direction, c.level)
+        spans.append((c.start, c.end, c_dir, c))
+        t = c.end
+    spans.append((t, Fraction(t1), c_dir, None))
+
+    def draw(start, dur, c_dir):
+        nonlocal last
+        ok = [x for x in HEAD_TARGETS if x != last and _head_ok(x, c_dir)]
         if not ok:
-            t += dur
-            continue
+            return  # only the head's present direction suits: it holds
         d, lv, _ = ok[int(rng.integers(len(ok)))]
         last = (d, lv, 0)
-        out.append(Symbol(t, dur, "head", d, lv))
-        t += dur
+        out.append(Symbol(start, dur, "head", d, lv))
+
+    for start, end, c_dir, c in spans:
+        if c is not None:
+            draw(c.start, c.duration, c_dir)
+            continue
+        t = start
+        while True:
+            t += _GAPS[int(rng.integers(len(_GAPS)))]
+            dur = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
+            if t + dur > end:
+                break
+            draw(t, dur, c_dir)
+            t += dur
+    return out
 
 
 def _split_arm_track(rng, side, t0, t1, chest=()):
@@ -184,28 +218,50 @@ def _split_arm_track(rng, side, t0, t1, chest=()):
         t += dur
 
 
-def _legs_track(rng, n_beats):
-    """Supports and leg gestures: weight transfers, free-leg gestures, steps."""
+def _other(foot: str) -> str:
+    return "left" if foot == "right" else "right"
+
+
+def _legs_track(rng, n_beats, bpm):
+    """Supports and leg gestures: weight transfers, free-leg gestures, steps.
+
+    A change of support level lasts at least :data:`LEVEL_CHANGE_S` seconds
+    at `bpm` (the fastest tempo of the score),
+    so the feet stay slower than DESIGN.md's 0.2 m/s support threshold (a
+    heel dropped from relevé to plié faster no longer reads as supporting).
+    After a step or a closing, the foot that has just landed keeps the
+    weight: the next support names it, or the other foot steps (released
+    at once, a foot that has just landed would never rest).
+    """
     out, t, end = [], Fraction(0), Fraction(n_beats)
+    slow = [d for d in _DURATIONS if d * 60 / bpm >= LEVEL_CHANGE_S] or [max(_DURATIONS)]
+    landed = None  # a foot that has just landed: it keeps the weight next
+    released = None  # the foot a step left off the floor
     while True:
         kind = ("both", "single", "step")[int(rng.choice(3, p=(0.35, 0.45, 0.2)))]
         dur = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
+        if kind in ("both", "single"):
+            dur = slow[int(rng.integers(len(slow)))]
         if kind == "both":
             if t + dur > end:
                 return out
             out.append(Symbol(t, dur, "support", "place", ("low", "middle", "high")[int(rng.integers(3))]))
             t += dur
         elif kind == "step":
-            foot = ("right", "left")[int(rng.integers(2))]
+            # After a step the other foot steps (a walk): the foot just
+            # landed bears the weight meanwhile.
+            foot = ("right", "left")[int(rng.integers(2))] if landed is None else _other(landed)
             d = ("forward", "back", foot)[int(rng.integers(3))]
             if t + dur > end:
                 return out
             out.append(Symbol(t, dur, f"{foot}_support", d, "middle"))
             t += dur
+            landed, released = foot, _other(foot)
+            continue
         else:
-            foot = ("right", "left")[int(rng.integers(2))]
-            free = "left" if foot == "right" else "right"
-            close = Fraction(1)
+            foot = ("right", "left")[int(rng.integers(2))] if landed is None else landed
+            free = _other(foot)
+            close = slow[0]
             gestures = []
             g_t, last = t + dur, None
             for _ in range(1 + int(rng.integers(2))):
@@ -223,6 +279,10 @@ def _legs_track(rng, n_beats):
             out += gestures
             out.append(Symbol(g_t, close, "support", "place", "middle"))
             t = g_t + close
+            landed, released = free, None  # the free foot has just closed
+            continue
+        # On both feet: a foot a step released has just closed.
+        landed, released = released, None
 
 
 def random_score(
@@ -273,6 +333,9 @@ def random_score(
     parts = tuple(parts)
     if not set(parts) <= known:
         raise SyntheticError(f"unknown parts {sorted(set(parts) - known)}; expected some of {sorted(known)}")
+    # Supports are timed for the fastest tempo that may be drawn (the tempo
+    # is drawn after the symbols, keeping the arms' and head's draws).
+    legs_bpm = Fraction(120) if tempo is None else Fraction(tempo)
     for _ in range(int(max_tries)):
         syms: list = []
         chest: list = []
@@ -284,7 +347,7 @@ def random_score(
             elif p == "head":
                 syms += _head_track(rng, chest, n_beats)
             elif p == "legs":
-                syms += _legs_track(rng, n_beats)
+                syms += _legs_track(rng, n_beats, legs_bpm)
             elif p in ("right_arm", "left_arm") and split_arms:
                 syms += _split_arm_track(rng, p.split("_")[0], 0, n_beats, chest)
             elif p in ("right_arm", "left_arm"):
@@ -302,7 +365,7 @@ def random_score(
         score = Score(tuple(syms), title="random", tempo=bpm, meter=4, effort=effort)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", UnreachableWarning)
-            interpret(score, fps=8.0)
+            interpret(score, fps=VERIFY_FPS)
         if not any(issubclass(w.category, UnreachableWarning) for w in caught):
             return score
     raise SyntheticError(f"no reachable random score in {max_tries} draws (n_beats={n_beats}, parts={parts})")

@@ -177,7 +177,9 @@ LIMITS_DEG: MappingProxyType = MappingProxyType(
         # For upright segments rx < 0 bends forward (flexion), rx > 0 back.
         "waist": ((-60, 30), (-35, 35), (-40, 40)),
         "chest": ((-30, 20), (-20, 20), (-30, 30)),
-        "neck": ((-70, 60), (-45, 45), (-80, 80)),
+        # The neck stands for the whole cervical spine and the head's nod:
+        # it bows the head to the horizontal (DESIGN.md's head forward middle).
+        "neck": ((-90, 60), (-45, 45), (-80, 80)),
         "head": ((0, 0), (0, 0), (0, 0)),
         # Shoulder flexion beyond 180 and a full circle of twist let the arm
         # pass through place high/low without a flip (Wolofsky ch. IV).

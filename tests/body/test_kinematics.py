@@ -98,6 +98,18 @@ def test_extremes_allow_anatomical_and_forbid_reverse_bends():
     assert lim[joint_index("left_hip"), 1, 1] >= 90 and lim[joint_index("right_hip"), 1, 0] <= -90
 
 
+def test_neck_bows_the_head_to_the_horizontal():
+    """DESIGN.md's ``head forward middle`` (a head bowed to the horizontal) is
+    within the neck's extreme; bending back to the horizontal is not."""
+    angles = np.zeros((1, J, 3))
+    angles[0, joint_index("neck"), 0] = BODY.limits[joint_index("neck"), 0, 0]
+    v = _pos("head", angles) - _pos("neck", angles)
+    assert np.degrees(np.arcsin(v[2] / np.linalg.norm(v))) == pytest.approx(0.0, abs=1e-9) and v[1] > 0
+    angles[0, joint_index("neck"), 0] = BODY.limits[joint_index("neck"), 0, 1]
+    v = _pos("head", angles) - _pos("neck", angles)
+    assert np.degrees(np.arcsin(v[2] / np.linalg.norm(v))) > 22.5  # still reads high
+
+
 def test_left_extremes_mirror_the_right():
     for name in ("shoulder", "elbow", "hip", "knee", "ankle"):
         r, l = BODY.limits[joint_index("right_" + name)], BODY.limits[joint_index("left_" + name)]

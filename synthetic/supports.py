@@ -1,0 +1,390 @@
+"""Supports: where the feet stand, where the weight is, and the legs that follow.
+
+Support symbols (``support`` = both feet, ``right_support``,
+``left_support``): level low = plié (knees bent :data:`PLIE_BEND_DEG`),
+middle, high = relevé (ankles plantar-flexed :data:`RELEVE_DEG`, heels
+raised, the body rises); a direction other than place is a step of
+:data:`STEP_LENGTH` × height that way, the foot lifting on the way.  At the
+end of each support symbol the pelvis is over the mean of the weight-bearing
+feet and as high as their levels allow, so the supporting feet stay on the
+floor; a foot whose support ended is free as soon as a gesture of its leg
+starts.  A gesturing foot never goes below the floor (the knee bends and the
+foot flexes instead).
+
+:class:`Support` plans the root (pelvis) trajectory and the world targets of
+both ankles; :func:`leg_tracks` turns them, and the leg gestures, into
+thigh frames, knee bends and ankle angles.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from capture2notation.body import Body, euler_to_matrix, joint_index
+from capture2notation.effort.model import progress
+from capture2notation.errors import SyntheticError
+from capture2notation.notation.directions import canonical_vector
+from capture2notation.notation.model import Effort, Score
+
+from .extremes import keep_paths_within
+from .limbs import Limb, apply_move, group_moves
+from .motion import euler_near
+from .rotations import rot_x, slerp_frames, unit
+
+__all__ = ["STEP_LENGTH", "PLIE_BEND_DEG", "RELEVE_DEG", "STEP_LIFT", "SUPPORT_FEET", "Support", "leg_tracks"]
+
+log = logging.getLogger(__name__)
+
+#: Step length as a fraction of body height.
+STEP_LENGTH = 0.18
+#: Knee bend of a plié (support level low), degrees (> 30° so it reads low).
+PLIE_BEND_DEG = 45.0
+#: Ankle plantar flexion of a relevé (support level high), degrees.
+RELEVE_DEG = 35.0
+#: Height a stepping foot is lifted mid-step, fraction of body height.
+STEP_LIFT = 0.03
+#: Vertical speed (m/s) at which a stepping or landing foot leaves and meets
+#: the floor.  It exceeds DESIGN.md's 0.2 m/s support threshold, so a foot
+#: reads as supporting from the end frame of its support symbol (within one
+#: frame), not while it is still settling: the step arrives at the end of its
+#: symbol, like a gesture.
+FOOT_CONTACT_SPEED = 0.5
+
+SUPPORT_FEET = {"support": ("right", "left"), "right_support": ("right",), "left_support": ("left",)}
+
+def _foot_events(score: Score, foot: str):
+    """Support symbols naming `foot` and gesture symbols of its leg, in time order."""
+    leg = {f"{foot}_leg", f"{foot}_thigh", f"{foot}_shin"}
+    sup = [s for s in score.symbols if s.part in SUPPORT_FEET and foot in SUPPORT_FEET[s.part]]
+    ges = [s for s in score.symbols if s.part in leg]
+    for a, b in zip(sup, sup[1:]):
+        if b.start < a.end:
+            raise SyntheticError(
+                f"{b.part} at beat {b.start} overlaps {a.part} at beat {a.start}-{a.end} on the {foot} foot"
+            )
+    for s in sup:
+        for g in ges:
+            if g.start < s.end and s.start < g.end:
+                raise SyntheticError(
+                    f"{s.part} at beat {s.start}-{s.end} overlaps the {foot} leg's gesture {g.part} "
+                    f"at beat {g.start}-{g.end}: a leg cannot gesture and support at once"
+                )
+    return sup, ges
+
+
+def _planted_after(sup, ges, beat) -> bool:
+    """Whether a foot bears weight just after `beat`.
+
+    Feet start planted; a gesture of the leg frees the foot from its start, a
+    support symbol plants it at its end; at a tie the gesture wins.
+    """
+    effects = [(s.end, 0, True) for s in sup if s.end <= beat]
+    effects += [(g.start, 1, False) for g in ges if g.start <= beat]
+    return max(effects)[2] if effects else True
+
+
+def foot_lift(tau, seconds: float, height: float):
+    """Height of a stepping or landing foot above its path, metres.
+
+    A trapezoid: the foot rises at :data:`FOOT_CONTACT_SPEED` from the
+    symbol's start, travels at `height` and comes down at the same speed to
+    touch the floor exactly at the symbol's end.
+
+    Parameters
+    ----------
+    tau : (n,) ndarray
+        Normalised time in [0, 1].
+    seconds : float
+        Duration of the symbol, seconds.
+    height : float
+        Greatest lift, metres.
+
+    Returns
+    -------
+    (n,) ndarray
+    """
+    t = np.asarray(tau, float) * seconds
+    return np.clip(np.minimum(FOOT_CONTACT_SPEED * t, FOOT_CONTACT_SPEED * (seconds - t)), 0.0, height)
+
+
+def _weight_feet(sups, events, beat) -> list:
+    """Feet bearing the weight just after `beat`.
+
+    Those named by the support symbols in force at `beat` (begun before it,
+    not yet ended), less feet whose leg starts a gesture by then; with no
+    support symbol in force, every planted foot.
+    """
+    named = {f for s in sups if s.start < beat <= s.end for f in SUPPORT_FEET[s.part]}
+    if not named:
+        return [f for f in ("right", "left") if _planted_after(*events[f], beat)]
+    return [f for f in ("right", "left") if f in named and _planted_after(*events[f], beat)]
+
+
+class Support:
+    """Root trajectory and foot targets implied by the support symbols."""
+
+    def __init__(self, score: Score, frame, T: int, eff: Effort, body: Body, fps: float):
+        self.body, self.T, self.eff, self.frame, self.fps = body, T, eff, frame, float(fps)
+        self.limbs = {f: Limb(f"{f}_leg", body) for f in ("right", "left")}
+        self.hip_off = {f: body.offsets[joint_index(f"{f}_hip")] for f in ("right", "left")}
+        self.ankle0 = body.rest[joint_index("right_ankle")][2]
+        self.toe0 = body.rest[joint_index("right_toe")][2]
+        toe = body.offsets[joint_index("right_toe")]
+        pitch = -np.radians(RELEVE_DEG)
+        self.rise = toe[2] - (rot_x(pitch) @ toe)[2]
+        self.level_z = {"low": self.ankle0, "middle": self.ankle0, "high": self.ankle0 + self.rise}
+        self.level_pitch = {"low": 0.0, "middle": 0.0, "high": pitch}
+        self.events = {f: _foot_events(score, f) for f in ("right", "left")}
+        self.root = np.tile(body.rest[0], (T, 1))
+        # Per foot and frame: ankle target (world), pitch, whether the leg is
+        # driven by the floor (planted or stepping) and whether it is landing.
+        self.ankle = {f: np.tile(body.rest[joint_index(f"{f}_ankle")], (T, 1)) for f in ("right", "left")}
+        self.pitch = {f: np.zeros(T) for f in ("right", "left")}
+        self.floor = {f: np.ones(T, bool) for f in ("right", "left")}
+        self.landing = {f: np.zeros(T, bool) for f in ("right", "left")}
+        self._plan(score)
+
+    def _leg_length(self, level):
+        limb = self.limbs["right"]
+        return float(limb.radius(np.radians(PLIE_BEND_DEG) if level == "low" else 0.0))
+
+    def _plan(self, score: Score):
+        frame, T, body = self.frame, self.T, self.body
+        xy = {f: body.rest[joint_index(f"{f}_ankle")][:2].copy() for f in ("right", "left")}
+        level = {f: "middle" for f in ("right", "left")}
+        sups = sorted((s for s in score.symbols if s.is_support), key=lambda s: (s.end, s.start))
+        for s in sups:
+            if s.part == "support" and s.direction != "place":
+                raise SyntheticError(
+                    f"support at beat {s.start}: a step on both feet ({s.direction}) is not supported; "
+                    "notate right_support / left_support steps instead"
+                )
+        last_key = 0
+        for s in sups:
+            f0, f1 = frame(s.start), frame(s.end)
+            n = np.arange(f0 + 1, f1 + 1)
+            tau = (n - f0) / max(f1 - f0, 1)
+            # The foot travels with the Effort progress and touches down on
+            # the end frame; the transfer of weight takes the whole symbol.
+            sf = progress(tau, self.eff.time, self.eff.weight)
+            lift = foot_lift(tau, (f1 - f0) / self.fps, STEP_LIFT * body.height)
+            # A foot bears weight if the supports in force name it (a step
+            # onto the other foot releases it, as a gesture of its leg does).
+            bearing = _weight_feet(sups, self.events, s.start)
+            for foot in SUPPORT_FEET[s.part]:
+                planted = foot in bearing
+                other = "left" if foot == "right" else "right"
+                if planted:
+                    base = xy[foot]
+                elif other in bearing:
+                    # Closing: beside the supporting foot, at standing width.
+                    base = xy[other] + (self.hip_off[foot] - self.hip_off[other])[:2]
+                else:
+                    base = self.root[f0, :2] + self.hip_off[foot][:2]
+                target = base.copy()
+                if s.direction != "place":
+                    target = base + STEP_LENGTH * body.height * canonical_vector(s.direction, "middle")[:2]
+                za, zb = self.ankle[foot][f0, 2], self.level_z[s.level]
+                pa, pb = self.pitch[foot][f0], self.level_pitch[s.level]
+                a = self.ankle[foot]
+                a[n, :2] = base + sf[:, None] * (target - base)
+                a[n, 2] = za + sf * (zb - za)
+                if s.direction != "place" and planted:
+                    a[n, 2] += lift
+                self.pitch[foot][n] = pa + sf * (pb - pa)
+                if not planted:
+                    # Landing from a gesture: :func:`leg_tracks` blends the
+                    # leg from its gesture pose to these (lifted) targets.
+                    a[n] = [target[0], target[1], zb]
+                    a[n, 2] += lift
+                    self.pitch[foot][n] = pb
+                    self.landing[foot][n] = True
+                    self.floor[foot][f0 + 1 : f1 + 1] = True
+                a[f1 + 1 :] = [target[0], target[1], zb]
+                self.pitch[foot][f1 + 1 :] = pb
+                xy[foot], level[foot] = target, s.level
+            # Weight: the pelvis ends over the mean of the weight-bearing feet,
+            # as high as their legs (at their levels) allow.
+            feet = _weight_feet(sups, self.events, s.end)
+            if not feet:
+                log.info("no foot bears weight after beat %s; the pelvis holds", s.end)
+                continue
+            key = self.root[f1].copy()
+            key[:2] = np.mean([xy[f] for f in feet], axis=0)
+            zs = []
+            for f in feet:
+                h = np.linalg.norm(key[:2] + self.hip_off[f][:2] - xy[f])
+                L = self._leg_length(level[f])
+                zs.append(self.level_z[level[f]] + np.sqrt(max(L * L - h * h, 0.0)))
+            key[2] = min(zs)
+            fa = max(f0, last_key)
+            m = np.arange(fa + 1, f1 + 1)
+            if f1 > fa:
+                # The weight arrives with the foot, on the end frame.
+                tau = (m - fa) / (f1 - fa)
+                sr = progress(tau, self.eff.time, self.eff.weight)
+                ra = self.root[fa].copy()
+                self.root[m] = ra + sr[:, None] * (key - ra)
+            self.root[f1:] = key
+            last_key = max(last_key, f1)
+        # Gesturing frames: from a gesture's start to the next support's start.
+        for foot in ("right", "left"):
+            sup, ges = self.events[foot]
+            for g in ges:
+                nxt = min((x.start for x in sup if x.start >= g.end), default=None)
+                stop = T if nxt is None else frame(nxt) + 1
+                self.floor[foot][frame(g.start) + 1 : stop] = False
+
+    def ik(self, foot: str, ankle_pos=None, foot_R=None, frames=slice(None)):
+        """Leg pose putting the ankle at `ankle_pos` with the foot turned to `foot_R`.
+
+        Parameters
+        ----------
+        foot : str
+            ``"right"`` or ``"left"``.
+        ankle_pos : (n, 3) ndarray, optional
+            World ankle targets; default the planned ones.
+        foot_R : (n, 3, 3) ndarray, optional
+            World foot orientations; default flat or in relevé as planned.
+        frames : slice or index array
+            Frames concerned (the hip follows the root there).
+
+        Returns
+        -------
+        Q : (n, 3, 3) ndarray
+            Thigh frames (body frame).
+        beta : (n,) ndarray
+            Knee bend, radians.
+        ankle : (n, 3) ndarray
+            Ankle Euler angles, within the extremes.
+        """
+        limb = self.limbs[foot]
+        hip = (self.root + self.hip_off[foot])[frames]
+        ankle_pos = (self.ankle[foot][frames] if ankle_pos is None else ankle_pos).copy()
+        foot_R = rot_x(self.pitch[foot][frames]) if foot_R is None else foot_R
+        ja = joint_index(f"{foot}_ankle")
+        lim = self.body.limits[ja]
+        toe = self.body.offsets[joint_index(f"{foot}_toe")]
+        for _ in range(4):
+            v = ankle_pos - hip
+            l = np.linalg.norm(v, axis=-1)
+            beta = limb.bend_for_radius(np.minimum(l, limb.reach))
+            Q = limb.fit_twist(limb.swing(v / l[:, None]), beta)
+            shin = Q @ rot_x(limb.middle_angle(beta))
+            ankle = np.clip(euler_near(shin.transpose(0, 2, 1) @ foot_R, 0.0, lim), lim[:, 0], lim[:, 1])
+            # Past the ankle's extremes (a plié with the feet far apart) the
+            # foot cannot stay flat: the heel lifts so the toe stays on the floor.
+            deficit = self.toe0 - (ankle_pos + (shin @ euler_to_matrix(ankle)) @ toe)[:, 2]
+            if not np.any(deficit > 1e-6):
+                break
+            ankle_pos[:, 2] += np.maximum(deficit, 0.0)
+        return Q, beta, ankle
+
+
+def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
+    """Final leg poses: floor-driven where planted, gestures elsewhere."""
+    out = {}
+    for foot in ("right", "left"):
+        limb = sup.limbs[foot]
+        Q, beta, ankle = sup.ik(foot)
+        floor, landing = sup.floor[foot], sup.landing[foot]
+        Qg, bg = Q.copy(), beta.copy()
+        ankle_g = ankle.copy()
+        for f0, f1, syms in group_moves(limb, symbols, frame, T):
+            stop = f1 + 1 + int(np.argmax(floor[f1 + 1 :])) if np.any(floor[f1 + 1 :]) else T
+            a0 = ankle_g[f0].copy()
+            s = apply_move(limb, Qg, bg, f0, f1, syms, eff, stop)
+            ankle_g[f0 + 1 : f1 + 1] = a0 * (1.0 - s)[:, None]
+            ankle_g[f1 + 1 : stop] = 0.0
+        own = [(x, frame(x.start), frame(x.end)) for x in symbols if x.part in (limb.whole, limb.upper, limb.lower)]
+        Qg, bg = _within_extremes(limb, Qg, bg, own, eff, sup.body)
+        # Landing: the ankle travels from where the gesture left it to its
+        # floor target while the foot turns flat (faster, so the toe does
+        # not catch the floor); the leg follows by IK.
+        idx = np.flatnonzero(landing)
+        hip = sup.root + sup.hip_off[foot]
+        for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []:
+            g = run[0] - 1
+            w = progress(np.arange(1, run.size + 1) / run.size, eff.time, eff.weight)
+            shin_g = Qg[g] @ rot_x(limb.middle_angle(bg[g]))
+            a_g = hip[g] + Qg[g] @ sup.body.offsets[limb.joints[1]] + shin_g @ sup.body.offsets[limb.joints[2]]
+            F_g = shin_g @ euler_to_matrix(ankle_g[g])
+            target = sup.ankle[foot][run]
+            wo = np.minimum(1.0, 1.5 * w)
+            F = slerp_frames(F_g, rot_x(sup.pitch[foot][run[-1]]), wo * wo * (3.0 - 2.0 * wo))
+            # About the hip, not along a straight line: the leg keeps its
+            # length as it comes down and folds only near the floor, so a
+            # high leg does not bend its knee (which would lift the thigh
+            # past the hip's extreme).
+            u_g = a_g - hip[g]
+            v_t = target - hip[run]
+            r = np.linalg.norm(u_g) + w**3 * (np.linalg.norm(v_t, axis=-1) - np.linalg.norm(u_g))
+            u = (1.0 - w)[:, None] * u_g / np.linalg.norm(u_g) + w[:, None] * unit(v_t)
+            Q[run], beta[run], ankle[run] = sup.ik(foot, hip[run] + r[:, None] * unit(u), F, run)
+        gest = ~floor
+        Q[gest], beta[gest], ankle[gest] = Qg[gest], bg[gest], ankle_g[gest]
+        free = gest
+        # The free foot stays above the floor (z = 0): the ankle no lower than
+        # the sole's thickness (its standing height less the toe's), and the
+        # toe above the floor too (a pitched foot reaches lower than its
+        # ankle), by bending the knee.
+        floor_z = np.full(T, sup.ankle0 - sup.toe0)
+        Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
+        ja = limb.joints[2]
+        lim = sup.body.limits[ja]
+        for _ in range(20):
+            deficit = -_toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
+            low = free & (deficit > 1e-6)
+            if not np.any(low):
+                break
+            # Near the floor the free foot flexes towards flat, and the knee
+            # bends (which also tips the foot down: overshoot a little).
+            shin = Qf[low] @ rot_x(limb.middle_angle(bf[low]))
+            flat = np.clip(euler_near(shin.transpose(0, 2, 1), 0.0, lim), lim[:, 0], lim[:, 1])
+            ankle[low, 0] = np.maximum(ankle[low, 0], flat[:, 0])
+            floor_z[low] += 2.0 * deficit[low] + 1e-4
+            Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
+        out[f"{foot}_leg"] = (Qf, bf, ankle)
+    return out
+
+
+def _within_extremes(limb: Limb, Q, beta, events, eff: Effort, body: Body):
+    """Leg gestures whose direct path leaves the hip's extremes, straightened.
+
+    Done here, before the floor is enforced, so a straightened leg still
+    stays above the floor (:func:`synthetic.extremes.keep_paths_within`).
+    """
+    if not events:
+        return Q, beta
+    ja, jm, _ = limb.joints
+    a = np.zeros((len(Q), len(body.rest), 3))
+    a[:, ja] = euler_near(Q, 0.0, body.limits[ja])
+    a[:, jm, 0] = limb.middle_angle(beta)
+    keep_paths_within(a, body, events, eff)
+    return euler_to_matrix(a[:, ja]), limb.sign * a[:, jm, 0]
+
+
+def _toe(body: Body, foot: str, limb: Limb, Q, beta, ankle, hip):
+    """(T,3) toe positions of a leg posed by hip frames `Q`, bend `beta`, ankle angles."""
+    shin = Q @ rot_x(limb.middle_angle(beta))
+    knee = hip + Q @ body.offsets[joint_index(f"{foot}_knee")]
+    ank = knee + shin @ body.offsets[joint_index(f"{foot}_ankle")]
+    return ank + (shin @ euler_to_matrix(ankle)) @ body.offsets[joint_index(f"{foot}_toe")]
+
+
+def _keep_above_floor(limb: Limb, Q, beta, hip, floor_z, mask):
+    """Bend the knee of free legs whose ankle would go below `floor_z` (T,)."""
+    P = limb.whole_frame(Q, beta)
+    d = -P[:, :, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lmax = np.where(d[:, 2] < -1e-9, (hip[:, 2] - floor_z) / -d[:, 2], np.inf)
+    bad = mask & (limb.radius(beta) > lmax)
+    if np.any(bad):
+        nb = limb.bend_for_radius(np.maximum(lmax[bad], abs(limb.L1 - limb.L2) + 1e-6))
+        beta = beta.copy()
+        beta[bad] = np.maximum(beta[bad], nb)
+        Q = Q.copy()
+        Q[bad] = limb.upper_frame(P[bad], beta[bad])
+    return Q, beta
