@@ -1,16 +1,21 @@
 """Benchmark of the capture stage: speed and symbol accuracy.
 
-Run ``/work/venv/bin/python benchmarks/bench_capture.py [--random N] [--video K]``.
+Run ``/work/venv/bin/python benchmarks/bench_capture.py [--random N] [--noisy N] [--video K] [--view V]``.
 
 Prints (never asserts):
 
 1. quantisation speed (frames per second of :func:`segment_motion`);
 2. truth round trip: built-in phrases and N random scores interpreted by the
    virtual dancer, quantised from their truth joints — exact symbol matches
-   with the tempo given, and how often the estimated tempo is right;
-3. with ``--video K``: the whole capture (render → keypoints → fit →
+   with the tempo given, and whether the estimated tempo is right,
+   equivalent (a factor of two that puts every symbol at the same seconds
+   on the grid: the score is still exact when compared in time) or wrong;
+3. noisy truth (``--noisy N``): the built-ins and N random scores with 1 and
+   2 cm of Gaussian jitter on every joint coordinate (seeded) — agreement,
+   start error, exact and extra symbols, tempo, quantisation speed;
+4. with ``--video K``: the whole capture (render → keypoints → fit →
    quantise) on K random scores — symbol agreement, median start error and
-   frames per second of the whole capture.
+   frames per second of the whole capture, tempo given and estimated.
 
 :func:`score_agreement` is the reusable metric (it wraps
 :func:`capture2notation.quantise.agreement.compare_scores`).
@@ -98,7 +103,8 @@ def _round_trip(scores, fps: float):
     """(exact count, tempo right count, frames, quantisation seconds, failures) over `scores`."""
     from synthetic.interpret import interpret
 
-    exact = tempo_ok = frames = 0
+    exact = frames = 0
+    tempo_ok = {"right": 0, "equivalent": 0, "wrong": 0}
     seconds = 0.0
     agree = []
     failures = []
@@ -118,8 +124,20 @@ def _round_trip(scores, fps: float):
         agree.append(score_agreement(score, seg.score)["symbol_agreement"])
         if diffs:
             failures.append((name, diffs))
-        tempo_ok += segment_motion(joints, fps).tempo == score.tempo
+        tempo_ok[tempo_verdict(score, segment_motion(joints, fps), diffs)] += 1
     return exact, tempo_ok, frames, seconds, failures, float(np.mean(agree)), (missed, exact_reached)
+
+
+def tempo_verdict(score: Score, seg, diffs_given_tempo) -> str:
+    """``right``, ``equivalent`` or ``wrong``: the estimated tempo of `seg` against `score`.
+
+    Equivalent: another tempo whose score, compared in time, differs from
+    the written one exactly as the score captured with the tempo given does
+    (a factor of two with every start and duration on the grid).
+    """
+    if seg.tempo == score.tempo:
+        return "right"
+    return "equivalent" if score_differences(score, seg.score) == diffs_given_tempo else "wrong"
 
 
 def bench_truth(n_random: int, seed: int, fps: float = 25.0, show: int = 3) -> None:
@@ -143,11 +161,56 @@ def bench_truth(n_random: int, seed: int, fps: float = 25.0, show: int = 3) -> N
         total_s += secs
         n = len(scores)
         print(f"  {label:42s} exact {exact:3d}/{n} = {100 * exact / n:5.1f} %   agreement {100 * agree:5.1f} %   "
-              f"estimated tempo right {tempo_ok}/{n}")
+              f"estimated tempo right {tempo_ok['right']}/{n}, equivalent {tempo_ok['equivalent']}, "
+              f"wrong {tempo_ok['wrong']}")
         print(f"      the dancer reaches every written pose in {n - missed}/{n}; of those, exact {exact_reached}/{n - missed}")
         for name, diffs in failures[:show]:
             print(f"      {name}: " + "; ".join(diffs[:3]))
     print(f"  quantisation speed: {total_frames / total_s:,.0f} frames/s ({total_frames} frames)")
+
+
+def bench_noisy(n_random: int, seed: int, sigmas=(0.01, 0.02), fps: float = 25.0) -> None:
+    """Truth joints plus seeded Gaussian jitter: robustness of timing, tempo and symbols."""
+    import warnings
+
+    from capture2notation.quantise.agreement import normalise
+    from synthetic.interpret import interpret
+    from synthetic.phrases import builtin_phrases
+    from synthetic.random_scores import random_score
+
+    warnings.simplefilter("ignore")
+    rng = np.random.default_rng(seed)
+    scores = list(builtin_phrases().items()) + [
+        (f"random #{i}", random_score(rng, n_beats=8, random_effort=bool(i % 2))) for i in range(n_random)]
+    motions = [(name, score, interpret(score, fps=fps).joints()) for name, score in scores]
+    print(f"noisy truth: {len(scores)} scores (3 built-ins, {n_random} full random), jitter per joint coordinate")
+    for sigma in sigmas:
+        for given in (True, False):
+            agree, starts, verdicts, frames, secs = [], [], {"right": 0, "equivalent": 0, "wrong": 0}, 0, 0.0
+            n_ref = n_missing = n_extra = 0
+            for k, (name, score, joints) in enumerate(motions):
+                noisy = joints + np.random.default_rng(seed + k).normal(0.0, sigma, joints.shape)
+                t0 = time.perf_counter()
+                seg = segment_motion(noisy, fps, tempo=score.tempo if given else None)
+                secs += time.perf_counter() - t0
+                frames += len(noisy)
+                a = score_agreement(score, seg.score)
+                agree.append(a["symbol_agreement"])
+                starts.append(a["median_start_error"])
+                diffs = score_differences(score, seg.score)
+                extra = sum(d.startswith("extra") for d in diffs)
+                n_ref += len(normalise(score).symbols)
+                n_missing += len(diffs) - extra
+                n_extra += extra
+                if not given:
+                    ref_diffs = score_differences(score, segment_motion(noisy, fps, tempo=score.tempo).score)
+                    verdicts[tempo_verdict(score, seg, ref_diffs)] += 1
+            tempo = "given" if given else (f"estimated: right {verdicts['right']}, equivalent "
+                                           f"{verdicts['equivalent']}, wrong {verdicts['wrong']}")
+            print(f"  {100 * sigma:.0f} cm, tempo {tempo}")
+            print(f"      agreement {100 * np.mean(agree):5.1f} %, median start error {np.nanmedian(starts):.3f} beats, "
+                  f"symbols exact {100 * (1 - n_missing / n_ref):.1f} %, extra {n_extra / n_ref:.2f} per written symbol, "
+                  f"{frames / secs:,.0f} frames/s")
 
 
 def bench_video(k: int, seed: int, backend: str, view: str, size=(640, 480)) -> None:
@@ -169,27 +232,36 @@ def bench_video(k: int, seed: int, backend: str, view: str, size=(640, 480)) -> 
                           effort=False, overlay=False)
             dt = time.perf_counter() - t0
             a = score_agreement(score, res.score)
-            rows.append((a, res.n_frames, dt))
+            # The same fitted joints with the tempo estimated (compared in time).
+            est = segment_motion(np.asarray(res.motion.joints), float(res.motion.fps))
+            b = score_agreement(score, est.score)
+            rows.append((a, res.n_frames, dt, b, est.tempo == score.tempo))
             print(f"  score {i}: agreement {a['symbol_agreement']:.3f}, median start error "
-                  f"{a['median_start_error']:.3f} beats, {a['unmatched']} unmatched, {res.n_frames / dt:.1f} frames/s")
-    agree = np.mean([r[0]["symbol_agreement"] for r in rows])
-    starts = np.nanmedian([r[0]["median_start_error"] for r in rows])
+                  f"{a['median_start_error']:.3f} beats, {a['unmatched']} unmatched, {res.n_frames / dt:.1f} frames/s; "
+                  f"estimated tempo {est.tempo} (written {score.tempo}): agreement {b['symbol_agreement']:.3f}")
     fps = sum(r[1] for r in rows) / sum(r[2] for r in rows)
-    print(f"whole capture ({backend}, {view}, {size[0]}x{size[1]}, {k} random scores, tempo given)")
-    print(f"  symbol agreement (direction + level per part per beat): {100 * agree:.1f} %")
-    print(f"  median start-time error: {starts:.3f} beats")
+    print(f"whole capture ({backend}, {view}, {size[0]}x{size[1]}, {k} random scores)")
+    for label, col in (("tempo given", 0), ("tempo estimated", 3)):
+        agree = np.mean([r[col]["symbol_agreement"] for r in rows])
+        starts = np.nanmedian([r[col]["median_start_error"] for r in rows])
+        print(f"  {label}: symbol agreement (direction + level per part per beat) {100 * agree:.1f} %, "
+              f"median start-time error {starts:.3f} beats")
+    print(f"  estimated tempo right in {sum(r[4] for r in rows)}/{k}")
     print(f"  speed: {fps:.1f} frames/s (render excluded)")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--random", type=int, default=20, help="random scores per family for the truth round trip")
+    ap.add_argument("--noisy", type=int, default=12, help="random scores of the noisy-truth benchmark (0: skip)")
     ap.add_argument("--video", type=int, default=0, help="random scores for the whole capture (slow)")
     ap.add_argument("--backend", default="blazepose", choices=("blazepose", "markers"))
     ap.add_argument("--view", default="front")
     ap.add_argument("--seed", type=int, default=2024)
     args = ap.parse_args()
     bench_truth(args.random, args.seed)
+    if args.noisy:
+        bench_noisy(args.noisy, args.seed + 2)
     if args.video:
         bench_video(args.video, args.seed + 1, args.backend, args.view)
 

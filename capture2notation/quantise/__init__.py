@@ -6,10 +6,11 @@
   :class:`~capture2notation.notation.Score` on a beat grid (tempo given or
   :func:`estimate_tempo`);
 * :func:`benesh_key_poses` / :func:`write_benesh` — Benesh key poses;
-* :func:`compare_scores` — symbol agreement and start-time error of two scores.
+* :func:`compare_scores` — symbol agreement and start-time error of two
+  scores, compared in time (their tempi may differ).
 """
 
-from .agreement import Agreement, compare_scores, normalise, score_differences, symbol_agreement
+from .agreement import Agreement, at_tempo, compare_scores, normalise, score_differences, symbol_agreement
 from .benesh import BeneshPose, Extremity, Orientation, Stave, benesh_key_poses, estimate_stave, write_benesh
 from .labels import FrameLabels, label_frames, write_labels_csv
 from .segment import Movement, SegmentParams, Segmentation, segment, segment_motion
@@ -25,6 +26,7 @@ __all__ = [
     "SegmentParams",
     "Segmentation",
     "Stave",
+    "at_tempo",
     "benesh_key_poses",
     "compare_scores",
     "estimate_stave",

@@ -11,14 +11,22 @@ become the transition they describe (``0 1 right_support``).  The support parts 
 ``right_support``, ``left_support``) form one column, ``supports``, whose
 state is (part, direction, level).
 
-* :func:`symbol_agreement` — direction + level per part per beat: at each
-  sample beat, the destination written for each part (the last symbol that
-  has started, else the default) must be equal.
-* :func:`start_errors` — for each reference gesture symbol, the beat
-  distance to the nearest captured symbol of the same part with the same
-  destination.
+Comparison happens in *time*: a captured score may be written at another
+tempo (an estimated tempo can be twice the written one, with every duration
+doubled), and says the same thing when its symbols happen at the same
+seconds.  So the candidate is first re-expressed at the reference's tempo
+(:func:`at_tempo`: every beat × reference tempo / candidate tempo, exact
+fractions), and every figure below is in reference beats.
+
+* :func:`symbol_agreement` — direction + level per part per beat: at the
+  centre of each reference beat, the destination written for each part
+  (the last symbol that has started, else the default) must be equal.
+* :func:`start_errors` — for each reference gesture symbol, the distance in
+  reference beats to the nearest captured symbol of the same part with the
+  same destination.
 * :func:`score_differences` — exact comparison (start, duration, part,
-  direction, level, bend) of the normal forms; empty when they are equal.
+  direction, level, bend) of the normal forms, in reference beats; empty
+  when they are equal.
 """
 
 from __future__ import annotations
@@ -34,6 +42,7 @@ from ..notation.model import GESTURE_PARTS, Score, Symbol
 __all__ = [
     "DEFAULT_STATE",
     "Agreement",
+    "at_tempo",
     "normalise",
     "state_at",
     "symbol_agreement",
@@ -124,6 +133,31 @@ def normalise(score: Score) -> Score:
     return Score(symbols=tuple(out), title=score.title, tempo=score.tempo, meter=score.meter)
 
 
+def at_tempo(score: Score, tempo) -> Score:
+    """`score` written at another tempo: the same symbols at the same seconds.
+
+    Parameters
+    ----------
+    score : Score
+    tempo : Fraction or int
+        Beats per minute (> 0) of the result.
+
+    Returns
+    -------
+    Score
+        Every start and duration multiplied by ``tempo / score.tempo``
+        (exact fractions; off a coarse grid when the ratio is not a simple one).
+    """
+    tempo = Fraction(tempo)
+    if tempo <= 0:
+        raise CompareError(f"tempo must be > 0 beats per minute, got {tempo}")
+    k = tempo / score.tempo
+    if k == 1:
+        return score
+    syms = tuple(Symbol(s.start * k, s.duration * k, s.part, s.direction, s.level, s.bend) for s in score.symbols)
+    return score.replace(symbols=syms, tempo=tempo)
+
+
 def state_at(score: Score, part: str, beats) -> list[tuple]:
     """Destination (direction, level) written for `part` at each beat.
 
@@ -169,25 +203,31 @@ def _parts(ref: Score, cand: Score) -> list[str]:
 def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> float:
     """Fraction of (part, beat) cells where both scores write the same direction and level.
 
+    Each cell is sampled at its centre, so timing errors under half a step
+    cost nothing here (see :func:`start_errors` for them).
+
     Parameters
     ----------
     ref, cand : Score
-        Any scores (normalised here); compared on their own beat scales.
+        Any scores (normalised here); `cand` is compared at the same seconds
+        (:func:`at_tempo`), sampled on the reference's beats.
     step : Fraction
-        Sampling step in beats (1 = per beat).
+        Sampling step in reference beats (1 = per beat).
 
     Returns
     -------
     float
         In [0, 1]; 1.0 when neither score writes anything.
     """
-    ref, cand = normalise(ref), normalise(cand)
+    ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
     parts = _parts(ref, cand)
     end = max(ref.duration, cand.duration)
     n = int(np.ceil(end / step)) if end > 0 else 0
     if not parts or n == 0:
         return 1.0
-    beats = [k * step for k in range(n)]
+    # Cell centres: a symbol starting a frame late (or a tempo a bpm off)
+    # does not lose its whole cell; start errors are reported on their own.
+    beats = [(k + Fraction(1, 2)) * step for k in range(n)]
     same = total = 0
     for p in parts:
         a, b = state_at(ref, p, beats), state_at(cand, p, beats)
@@ -197,17 +237,18 @@ def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> f
 
 
 def start_errors(ref: Score, cand: Score) -> tuple[np.ndarray, int]:
-    """Start-time errors of reference gesture symbols, beats.
+    """Start-time errors of reference gesture symbols, reference beats.
 
     Returns
     -------
     errors : (M,) ndarray
-        |start difference| to the nearest captured symbol of the same part
-        with the same destination, for each matched reference symbol.
+        |start difference| (reference beats, the candidate taken at the same
+        seconds) to the nearest captured symbol of the same part with the
+        same destination, for each matched reference symbol.
     unmatched : int
         Reference gesture symbols with no such captured symbol.
     """
-    ref, cand = normalise(ref), normalise(cand)
+    ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
     errs, missing = [], 0
     for s in ref.symbols:
         if s.is_support:
@@ -227,13 +268,16 @@ class Agreement:
     Attributes
     ----------
     symbol_agreement : float
-        Direction + level per part per beat, in [0, 1].
+        Direction + level per part per reference beat, in [0, 1].
     median_start_error : float
-        Beats (NaN when nothing matched).
+        Reference beats (NaN when nothing matched).
     matched, unmatched : int
         Reference gesture symbols with / without a captured counterpart.
     exact : bool
-        The normal forms are identical.
+        The normal forms are identical at the same seconds (the tempi may
+        differ: see `tempo_ratio`).
+    tempo_ratio : Fraction
+        Candidate tempo / reference tempo (1 when written at the same tempo).
     """
 
     symbol_agreement: float
@@ -241,10 +285,23 @@ class Agreement:
     matched: int
     unmatched: int
     exact: bool
+    tempo_ratio: Fraction = Fraction(1)
 
 
 def compare_scores(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> Agreement:
-    """All agreement figures of `cand` against `ref`."""
+    """All agreement figures of `cand` against `ref`, in time (reference beats).
+
+    Parameters
+    ----------
+    ref, cand : Score
+        Reference and candidate; their tempi may differ.
+    step : Fraction
+        Sampling step of the agreement, reference beats.
+
+    Returns
+    -------
+    Agreement
+    """
     if not isinstance(ref, Score) or not isinstance(cand, Score):
         raise CompareError(f"compare_scores needs two Score objects, got {type(ref).__name__} and {type(cand).__name__}")
     errs, missing = start_errors(ref, cand)
@@ -254,6 +311,7 @@ def compare_scores(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> Agr
         matched=int(errs.size),
         unmatched=int(missing),
         exact=not score_differences(ref, cand),
+        tempo_ratio=cand.tempo / ref.tempo,
     )
 
 
@@ -267,16 +325,20 @@ def score_differences(ref: Score, cand: Score, supports: bool = True) -> list[st
     Parameters
     ----------
     ref, cand : Score
+        `cand` is compared at the same seconds (:func:`at_tempo`): a score
+        and the same score at another tempo with every time scaled have no
+        differences.
     supports : bool
         Include support symbols in the comparison.
 
     Returns
     -------
     list of str
-        ``"missing: …"`` (in `ref` only) and ``"extra: …"`` (in `cand` only).
+        ``"missing: …"`` (in `ref` only) and ``"extra: …"`` (in `cand`
+        only), times in reference beats.
     """
     a = {_key(s) for s in normalise(ref).symbols if supports or not s.is_support}
-    b = {_key(s) for s in normalise(cand).symbols if supports or not s.is_support}
+    b = {_key(s) for s in normalise(at_tempo(cand, ref.tempo)).symbols if supports or not s.is_support}
 
     def fmt(k):
         start, dur, part, d, lv, bend = k

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import csv
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -33,6 +33,7 @@ __all__ = [
     "FrameLabels",
     "label_frames",
     "support_frames",
+    "with_supports",
     "write_labels_csv",
 ]
 
@@ -207,17 +208,8 @@ def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLab
     direction, level = classify_indices(vectors)
     bend = np.where(np.isnan(bend_deg), -1, bend_degree(bend_deg))
     supporting, sup_level = support_frames(joints, fps, floor)
-    g = len(PART_SEGMENTS)
-    for k, part in enumerate(("right_support", "left_support")):
-        c = g + SUPPORT_PARTS.index(part)
-        direction[:, c] = np.where(supporting[:, k], PLACE, -1)
-        level[:, c] = sup_level[:, k]
-    both = supporting.all(axis=1) & (sup_level[:, 0] == sup_level[:, 1])
-    c = g + SUPPORT_PARTS.index("support")
-    direction[:, c] = np.where(both, PLACE, -1)
-    level[:, c] = np.where(both, sup_level[:, 0], -1)
     times = np.arange(T) / float(fps)
-    return FrameLabels(
+    labels = FrameLabels(
         times=times,
         parts=LABEL_PARTS,
         direction=direction.astype(int),
@@ -228,6 +220,39 @@ def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLab
         supporting=supporting,
         support_level=sup_level,
     )
+    return with_supports(labels, supporting, sup_level)
+
+
+def with_supports(labels: FrameLabels, supporting: np.ndarray, level: np.ndarray) -> FrameLabels:
+    """`labels` with other feet contacts (e.g. from smoothed joints) and their support columns.
+
+    Parameters
+    ----------
+    labels : FrameLabels
+    supporting : (T, 2) ndarray of bool
+        Right, left foot supporting.
+    level : (T, 2) ndarray of int
+        Index into ``LEVELS`` of each foot's support, −1 where it does not support.
+
+    Returns
+    -------
+    FrameLabels
+        ``right_support`` / ``left_support`` are ``place`` at their foot's
+        level while it supports; ``support`` is ``place`` when both feet
+        support at the same level.
+    """
+    direction, lev = labels.direction.copy(), labels.level.copy()
+    g = len(PART_SEGMENTS)
+    for k, part in enumerate(("right_support", "left_support")):
+        c = g + SUPPORT_PARTS.index(part)
+        direction[:, c] = np.where(supporting[:, k], PLACE, -1)
+        lev[:, c] = np.where(supporting[:, k], level[:, k], -1)
+    both = supporting.all(axis=1) & (level[:, 0] == level[:, 1])
+    c = g + SUPPORT_PARTS.index("support")
+    direction[:, c] = np.where(both, PLACE, -1)
+    lev[:, c] = np.where(both, level[:, 0], -1)
+    return replace(labels, direction=direction, level=lev, supporting=np.asarray(supporting, bool),
+                   support_level=np.where(supporting, level, -1).astype(int))
 
 
 def labels_csv_text(labels: FrameLabels) -> str:

@@ -22,9 +22,15 @@ Noisy motion (fitted, mocap)
     Savitzky–Golay smoothing over 0.3–0.6 s (wider for more jitter); a
     movement exceeds the jitter's 99th-percentile speed and peaks above
     ``peak_speed_deg_s`` (hysteresis), splits at interior minima deeper than
-    ``split_ratio``, keeps where it exceeds a tenth of its peak, must move
-    ``min_amplitude_deg``; key times of different parts within
-    ``merge_window_s`` are pulled together.
+    ``split_ratio``, must move ``min_amplitude_deg``.  Its start and arrival
+    are those of the Effort logistic fitted to its raw progress
+    (:mod:`.timing`) — a speed threshold cuts a fifth to a third off each
+    end — and it must last :data:`_MIN_MOVE_S` (quicker swings are glitches
+    of the fit); its label is the mean pose over up to :data:`_HOLD_S` of
+    the hold after the arrival, and it is written only when that label
+    differs from the part's previous one.  Key times of different parts
+    within ``merge_window_s`` are pulled together.  Feet contacts come from
+    smoothed joints (:func:`~.supports.smooth_positions`).
 
 Whole limb or segments
     Arms and legs are written as whole limbs (``right_arm`` …) with the bend
@@ -55,10 +61,11 @@ from scipy.signal import savgol_filter
 from ..errors import QuantiseError
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
-from .labels import DIRECTION_NAMES, FrameLabels, label_frames
+from .labels import DIRECTION_NAMES, FrameLabels, label_frames, support_frames, with_supports
 from .spans import _ZERO_SPEED, movement_spans
-from .supports import support_movements
+from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
 from .tempo import estimate_tempo, snap
+from .timing import progress_signal, refine_times
 
 __all__ = ["SegmentParams", "Movement", "Segmentation", "movement_spans", "segment", "segment_motion"]
 
@@ -157,6 +164,12 @@ _FOOT = {"right_leg": 0, "left_leg": 1}
 #: virtual dancer's truth measures ≤ 0.02°, optical mocap ≥ 0.1°): not
 #: smoothed, and split only at exactly written poses.
 _CLEAN_NOISE_DEG = 0.05
+#: Shortest noisy movement, seconds (start to arrival of the fitted
+#: logistic): half a beat at 150 bpm; anything quicker is a glitch of the
+#: fit (a flip of depth, a swapped limb), not a dance movement.
+_MIN_MOVE_S = 0.2
+#: Longest hold after a noisy arrival over which the pose is averaged, seconds.
+_HOLD_S = 0.4
 
 
 def _angle_deg(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -284,12 +297,31 @@ def segment_motion(
     if T < 2:
         raise QuantiseError(f"need at least 2 frames to segment a motion, got {T}")
     joints = np.asarray(joints, dtype=float)
+    # Measured motion (fits, mocap) is never exactly still, however smooth.
+    measured = not _has_exact_holds(labels, joints)
+    noisy_feet = measured or position_noise(joints) > NOISY_POSITION_M
+    if noisy_feet:
+        # Jitter of a centimetre is 0.5 m/s frame to frame: feet would never
+        # be "slower than 0.2 m/s" (DESIGN.md).  Contacts come from smoothed
+        # joints, for the supports and for the legs alike.
+        labels = with_supports(labels, *support_frames(smooth_positions(joints, fps), fps, floor))
     estimated = tempo is None
+    moves = None
     if estimated:
-        moves = _gesture_movements(labels, joints, fps, params) + support_movements(
-            labels, joints, fps, params, movement_spans
+        moves = _gesture_movements(labels, joints, fps, params, measured=measured) + support_movements(
+            labels, joints, fps, params, movement_spans, measured=measured
         )
-        times = np.array([t for m in moves for t in (m.start_time, m.end_time)])
+        clean = not measured and all(_noise_deg(labels.vectors[:, labels.index(p)]) <= _CLEAN_NOISE_DEG for p in _LIMBS)
+        # Gestures set the tempo when there are a few of them: support
+        # movements are cut at speed minima (clean) or fitted to the pelvis
+        # (noisy), a frame or more off their beats, and steps arrive early
+        # (the foot lands first).
+        timed = [m for m in moves if not m.part.endswith("support")]
+        timed = timed if len(timed) >= 4 else moves
+        times = np.array([t for m in timed for t in (m.start_time, m.end_time)])
+        # Fitted starts and arrivals carry different timing biases (a heavy,
+        # late-peaking Effort is fitted with a late arrival): groups 0 and 1.
+        groups = np.tile([0, 1], len(timed))
         if len(moves) == 0:
             # Nothing moves: the (empty) score needs some tempo; say so, invent nothing else.
             warnings.warn("no movement found: the tempo cannot be estimated, writing 60 bpm", stacklevel=2)
@@ -297,18 +329,22 @@ def segment_motion(
         else:
             gestures = [m.end_time - m.start_time for m in moves if not m.part.endswith("support")]
             # Clean key times are within half a frame of their grid time;
-            # measured ones (smoothed, noisy) within a couple of frames.
-            clean = all(_noise_deg(labels.vectors[:, labels.index(p)]) <= _CLEAN_NOISE_DEG for p in _LIMBS)
-            tol = (0.6 if clean else 2.0) / fps
-            tempo = estimate_tempo(times, params.grid, tolerance_s=tol, durations=gestures or None)
+            # measured ones (fitted logistic, noisy) within a frame or two.
+            tol = (0.3 if clean else 2.0) / fps
+            tempo = estimate_tempo(times, params.grid, tolerance_s=tol, durations=gestures or None, groups=groups,
+                                   max_offset_s=0.0 if clean else 3.0 / fps)
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
     if tempo <= 0:
         raise QuantiseError(f"tempo must be > 0 beats per minute, got {tempo}")
-    # With the beat grid known, clean motion is cut only on its frames.
-    on_grid = _grid_frames(T, fps, tempo, params.grid)
-    moves = _gesture_movements(labels, joints, fps, params, on_grid) + support_movements(
-        labels, joints, fps, params, movement_spans, on_grid
-    )
+    # With the beat grid known, clean motion is cut only on its frames;
+    # noisy motion never uses the grid, so its first pass stands.
+    noisy = noisy_feet and (measured or params.smooth_s is not None or all(
+        max(_noise_deg(u) for u in _channel(labels, joints, p)[0]) > _CLEAN_NOISE_DEG for p in tuple(_LIMBS) + _SINGLE))
+    if moves is None or not noisy:
+        on_grid = _grid_frames(T, fps, tempo, params.grid)
+        moves = _gesture_movements(labels, joints, fps, params, on_grid, measured) + support_movements(
+            labels, joints, fps, params, movement_spans, on_grid, measured=measured
+        )
     moves.sort(key=lambda m: (m.start_time, m.part))
     merged = _merge_times(moves, params, float(tempo))
     symbols = _symbols(merged, tempo, params.grid)
@@ -466,20 +502,38 @@ def _limb_symbols(labels: FrameLabels, part: str, start_f: int, end_f: int, fram
     return [(_LIMBS[part][0], d1, lv1), (_LIMBS[part][1], d2, lv2)]
 
 
+def _has_exact_holds(labels: FrameLabels, joints: np.ndarray, min_intervals: int = 3) -> bool:
+    """Whether some part (or the pelvis) both moves and holds exactly still (≥ `min_intervals` frame intervals).
+
+    The virtual dancer's truth holds a pose exactly (its vectors repeat to
+    the last bit), whereas fitted or recorded motion is never exactly still
+    however smooth its fit: a fitted capture can measure under 0.05° of
+    frame-to-frame jitter and would otherwise be taken for clean motion.
+    """
+    steps = [_angle_deg(u[:-1], u[1:]) for u in (labels.vectors[:, labels.index(p)] for p in tuple(_LIMBS) + _SINGLE)]
+    # The pelvis too (metres → millimetres): a plié moves little else.
+    steps.append(1e3 * np.linalg.norm(np.diff(joints[:, joint_index("pelvis")], axis=0), axis=-1))
+    return any(np.sum(st < 1e-9) >= min_intervals and np.nanmax(st, initial=0.0) > 0.01 for st in steps)
+
+
 def _gesture_movements(
-    labels: FrameLabels, joints: np.ndarray, fps: float, params: SegmentParams, on_grid: np.ndarray | None = None
+    labels: FrameLabels, joints: np.ndarray, fps: float, params: SegmentParams, on_grid: np.ndarray | None = None,
+    measured: bool = False,
 ) -> list[Movement]:
     out: list[Movement] = []
     T = labels.direction.shape[0]
-    hold = max(1, int(round(0.1 * fps)))
+    # Noisy poses are averaged over up to this long a hold after the arrival.
+    hold = max(1, int(round(_HOLD_S * fps)))
     for part in tuple(_LIMBS) + _SINGLE:
         whole = labels.index(part)
         u_list, reach, bend_list = _channel(labels, joints, part)
         noise = max([_noise_deg(u) for u in u_list] + [_scalar_noise(x) for x in bend_list])
-        clean = params.smooth_s is None and noise <= _CLEAN_NOISE_DEG
+        clean = params.smooth_s is None and not measured and noise <= _CLEAN_NOISE_DEG
         # Clean motion: the smooth reach, split at written poses only; noisy
         # motion: the bend itself (smoothed), split at deep speed minima.
         x_list = reach if clean else bend_list
+        # The logistic is fitted to the raw signals: smoothing would spread the movement.
+        raw_u, raw_x = u_list, x_list
         w = _smoothing_window(noise, fps, params)
         if w:
             u_list = [_smooth(u, w) for u in u_list]
@@ -493,25 +547,40 @@ def _gesture_movements(
             low = max(params.min_speed_deg_s, _noise_speed(noise, fps, w))
             high = max(params.peak_speed_deg_s, 2.0 * low)
         speed = _interval_speed(u_list, x_list, fps)
+        if part in _FOOT:
+            # A leg whose foot supports is part of the support (a plié bends
+            # the knee): it gestures only between leaving and reaching the floor.
+            down = labels.supporting[:, _FOOT[part]]
+            speed = np.where(down[:-1] & down[1:], 0.0, speed)
         key = _key_pose_fn(labels, part, on_grid) if clean else None
         spans = movement_spans(speed, low, high, params.split_ratio, key_pose=key)
         state = _DEFAULT.get(part, ("place", "low")) + (0,)
         for i, (a, b) in enumerate(spans):
             start_f, end_f = a, min(b + 1, T - 1)
             nxt = spans[i + 1][0] if i + 1 < len(spans) else T
-            # Clean motion is exactly on its pose at the arrival frame; noisy
-            # motion is averaged over the following hold.
-            frames = slice(end_f, end_f + 1) if clean else slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))
             moved = max([float(_angle_deg(u[start_f], u[end_f])) for u in u_list]
                         + [abs(float(x[end_f] - x[start_f])) for x in bend_list])
             if not moved >= params.min_amplitude_deg:
                 continue
+            # The movement leaves frame a's pose and arrives at frame b + 1's.
+            t0, t1 = a / fps, (b + 1) / fps
+            if clean:
+                # Clean motion is exactly on its pose at the arrival frame.
+                frames = slice(end_f, end_f + 1)
+            else:
+                # Noisy motion: the logistic's start and arrival, and the pose
+                # averaged over the hold that follows the arrival.
+                t0, t1 = _fitted_times(raw_u, raw_x, spans, i, fps, t0, t1)
+                if t1 - t0 < _MIN_MOVE_S:
+                    # A limb does not swing tens of degrees in a few frames
+                    # and back: a glitch of the measurement.
+                    continue
+                end_f = min(max(int(round(t1 * fps)), start_f + 1), T - 1)
+                frames = slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))
             if part in _FOOT and labels.supporting[end_f, _FOOT[part]]:
                 # A leg that arrives on the floor is a support, not a gesture.
                 state = ("place", "low", 0)
                 continue
-            # The movement leaves frame a's pose and arrives at frame b + 1's.
-            t0, t1 = a / fps, (b + 1) / fps
             if part in _LIMBS:
                 segs = _limb_symbols(labels, part, start_f, end_f, frames, params, clean)
                 if segs is not None:
@@ -528,6 +597,49 @@ def _gesture_movements(
             state = (d, lv, bend)
             out.append(Movement(part, start_f, end_f, t0, t1, d, lv, bend))
     return out
+
+
+def _progress_window(u_list: list, x_list: list, spans: list, i: int, fps: float):
+    """``(t, p, t0, t1)`` of span `i` for :func:`~.timing.refine_times`, or None.
+
+    The window runs from the previous movement's arrival (at most the
+    movement's own length earlier) to the next one's start; departure and
+    arrival poses are the means over the outer halves of the holds.  The
+    progress is that of the signal that changes most (a vector's angle or
+    the bend, both in degrees).
+    """
+    a, b = spans[i]
+    T = u_list[0].shape[0]
+    pad = max(3, b + 1 - a)
+    lo = max(spans[i - 1][1] + 1 if i > 0 else 0, a - pad)
+    hi = min(spans[i + 1][0] if i + 1 < len(spans) else T - 1, b + 1 + pad)
+    pre = slice(lo, max(lo + 1, (lo + a) // 2 + 1))
+    post = slice(min(hi, (b + 1 + hi + 1) // 2), hi + 1)
+    best, weight = None, 0.0
+    for u in u_list:
+        p0, p1 = np.nanmean(u[pre], axis=0), np.nanmean(u[post], axis=0)
+        p0, p1 = p0 / np.linalg.norm(p0), p1 / np.linalg.norm(p1)
+        amp = float(_angle_deg(p0, p1))
+        if np.isfinite(amp) and amp > weight:
+            best, weight = progress_signal(u[lo : hi + 1], p0, p1), amp
+    for x in x_list:
+        x0, x1 = np.nanmean(x[pre]), np.nanmean(x[post])
+        amp = abs(float(x1 - x0))
+        if np.isfinite(amp) and amp > weight:
+            best, weight = (x[lo : hi + 1] - x0) / (x1 - x0), amp
+    if best is None or hi - lo < 4:
+        return None
+    return np.arange(lo, hi + 1) / fps, best, a / fps, (b + 1) / fps
+
+
+def _fitted_times(u_list: list, x_list: list, spans: list, i: int, fps: float, t0: float, t1: float):
+    """Start and arrival of noisy span `i` from the Effort logistic (:mod:`.timing`);
+    the detected (`t0`, `t1`) when there is no window to fit."""
+    win = _progress_window(u_list, x_list, spans, i, fps)
+    if win is None:
+        return t0, t1
+    (f0, f1), = refine_times([win])
+    return max(f0, 0.0), f1
 
 
 def _merge_times(moves: list[Movement], params: SegmentParams, tempo: float) -> list[Movement]:

@@ -17,11 +17,17 @@ differs from the state before it becomes one symbol; its direction is
 ``place`` unless a weight-bearing foot travelled more than half a step
 (0.09 body heights) from under its hip — then the sector of that travel in
 the body frame (a step).
+
+Noisy motion (fitted joints, mocap: jitter above :data:`NOISY_POSITION_M`)
+has speeds as large as a plié's from the jitter alone, so there the
+movements are the changes of the mode-filtered support state instead,
+timed by the Effort logistic fitted to the pelvis
+(:func:`_noisy_support_movements`).
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+import warnings
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -31,7 +37,8 @@ from ..notation.directions import bend_angle, classify_indices
 from ..notation.model import LEVELS
 from .labels import DIRECTION_NAMES, FrameLabels
 
-__all__ = ["weight_bearing", "support_state", "support_movements", "STEP_MIN_FRACTION"]
+__all__ = ["MIN_GROUNDED", "MIN_PELVIS_M", "MIN_SUPPORT_S", "NOISY_POSITION_M", "STEP_MIN_FRACTION", "position_noise", "smooth_positions", "support_movements",
+           "support_state", "weight_bearing"]
 
 #: A weight-bearing foot that moved farther than this fraction of the body
 #: height from under its hip makes the support a step.
@@ -106,7 +113,46 @@ def _support_speed(labels: FrameLabels, joints: np.ndarray, fps: float) -> np.nd
     return np.linalg.norm(np.diff(x, axis=0), axis=1) * fps
 
 
-def _position_noise(joints: np.ndarray) -> float:
+def smooth_positions(joints: np.ndarray, fps: float, window_s: float = 0.3) -> np.ndarray:
+    """Savitzky–Golay smoothed joints (quadratic over `window_s`), for feet contacts of noisy motion.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        Metres; NaN where missing.
+    fps : float
+    window_s : float
+        Window, seconds (at least 5 frames).
+
+    Returns
+    -------
+    (T, J, 3) ndarray
+        Smoothed; missing samples stay NaN (interpolated only to smooth
+        their neighbours), and the input when it is shorter than the window.
+    """
+    joints = np.asarray(joints, dtype=float)
+    T = joints.shape[0]
+    w = max(5, int(round(window_s * fps)) | 1)
+    if T <= w:
+        return joints
+    flat = joints.reshape(T, -1)
+    bad = ~np.isfinite(flat)
+    filled = flat.copy()
+    if bad.any():
+        idx = np.arange(T)
+        for c in np.flatnonzero(bad.any(axis=0)):
+            ok = ~bad[:, c]
+            filled[:, c] = np.interp(idx, idx[ok], flat[ok, c]) if ok.any() else 0.0
+    out = savgol_filter(filled, w, 2, axis=0)
+    out[bad] = np.nan
+    return out.reshape(joints.shape)
+
+
+#: Jitter of the pelvis and feet (metres) above which motion counts as noisy.
+NOISY_POSITION_M = 1e-3
+
+
+def position_noise(joints: np.ndarray) -> float:
     """Jitter of the pelvis and feet, metres (lower quartile of the local-cubic residual; 0 when clean)."""
     idx = [joint_index(n) for n in ("pelvis", "right_ankle", "left_ankle")]
     p = joints[:, idx].reshape(joints.shape[0], -1)
@@ -132,41 +178,28 @@ def _mode_filter(x: np.ndarray, width: int) -> np.ndarray:
 
 
 def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, params, spans_fn,
-                      on_grid: np.ndarray | None = None) -> list:
+                      on_grid: np.ndarray | None = None, measured: bool = False) -> list:
     """Support movements as :class:`~.segment.Movement` objects (see the module docstring).
 
-    Noisy motion (jitter above 1 mm) is smoothed over 0.3 s first, and the
-    support state is mode-filtered over 0.3 s, so contact flicker does not
-    write symbols.
+    Noisy motion (jitter above :data:`NOISY_POSITION_M`, or `measured`:
+    fitted or recorded, never exactly still however smooth): see
+    :func:`_noisy_support_movements`; `labels` should then carry the contacts
+    of smoothed joints (:func:`smooth_positions`, as
+    :func:`~.segment.segment_motion` does).
     """
-    from .labels import support_frames
     from .segment import Movement
 
     T = joints.shape[0]
-    noise = _position_noise(joints)
-    noisy = noise > 1e-3
-    if noisy and T > 9:
-        w = max(5, int(round(0.3 * fps)) | 1)
-        if T > w:
-            filled = np.where(np.isfinite(joints), joints, np.nanmedian(joints, axis=0))
-            joints = savgol_filter(filled, w, 2, axis=0)
-            sup, lev = support_frames(joints, fps)
-            labels = replace(labels, supporting=sup, support_level=lev)
+    if measured or position_noise(joints) > NOISY_POSITION_M:
+        return _noisy_support_movements(labels, joints, fps)
     part, level = support_state(labels, joints)
-    if noisy:
-        w = max(3, int(round(0.3 * fps)) | 1)
-        code = _mode_filter((part + 1) * 4 + (level + 1), w)
-        part, level = code // 4 - 1, code % 4 - 1
     speed = _support_speed(labels, joints, fps)
-    if noisy:
-        low = max(params.min_speed_deg_s, 4.0 * float(np.nanpercentile(speed, 25)))
-        high = max(params.peak_speed_deg_s, 2.0 * low)
-        spans = spans_fn(speed, low, high, params.split_ratio)
-    else:
-        # Clean motion: any motion is a movement; back-to-back support
-        # symbols part at grid frames with both feet down and the speed at a
-        # local minimum (never mid-step, while a foot is in the air).
-        spans = spans_fn(speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid))
+    # Clean motion: any motion is a movement; back-to-back support
+    # symbols part at grid frames with both feet down and the speed at a
+    # local minimum (never mid-step, while a foot is in the air).
+    knees = np.stack([bend_angle(joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")],
+                                 joints[:, joint_index(f"{side}_ankle")]) for side in ("right", "left")], axis=1)
+    spans = spans_fn(speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees))
     height = _body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
     out = []
@@ -188,14 +221,132 @@ def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, param
     return out
 
 
-def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None):
-    """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements."""
+#: Noisy motion with feet on the floor in fewer frames than this fraction
+#: writes no support symbols (see :func:`_noisy_support_movements`).
+MIN_GROUNDED = 0.5
+#: Least pelvis displacement of a noisy support change, metres: a plié to
+#: the DESIGN.md threshold (knees 30°) lowers it 2.8 cm, a relevé raises it
+#: 5 cm, a weight transfer moves it 8-10 cm; contact flicker moves it not at all.
+MIN_PELVIS_M = 0.025
+#: Shortest grounded support state of noisy motion, seconds: shorter ones
+#: are contact flicker (or a foot's flight within a step).
+MIN_SUPPORT_S = 0.2
+
+
+def _runs(code: np.ndarray) -> list[tuple[int, int, int]]:
+    """Runs of equal values: (value, first frame, last frame)."""
+    edges = np.flatnonzero(np.diff(code)) + 1
+    starts = np.r_[0, edges]
+    ends = np.r_[edges - 1, len(code) - 1]
+    return [(int(code[a]), int(a), int(b)) for a, b in zip(starts, ends)]
+
+
+def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float) -> list:
+    """Support movements of noisy motion, from changes of the support state.
+
+    A centimetre of jitter makes the pelvis, knee and foot speeds as large
+    as a plié's, so movements are not found from speed here.  Instead the
+    support state (part, level) of the smoothed joints is mode-filtered over
+    0.3 s and cut into grounded runs of at least :data:`MIN_SUPPORT_S`; each
+    change of state between consecutive runs is one movement, and so is a
+    weight-bearing foot that left the floor and lands more than half a step
+    (DESIGN.md step rule, :data:`STEP_MIN_FRACTION`) from under its hip (a
+    step; a run on the other foot during a slow step's flight is still its
+    own symbol).  The movement's start and arrival are those
+    of the Effort logistic fitted to the pelvis's progress between the two
+    runs (:mod:`.timing`): every support change moves the pelvis (down in a
+    plié, up in a relevé, over the new support in a transfer or a step), so
+    a change that moves it less than :data:`MIN_PELVIS_M` is contact
+    flicker and writes nothing.
+    """
+    from .segment import Movement
+    from .timing import refine_times
+
+    T = joints.shape[0]
+    smooth = smooth_positions(joints, fps)
+    part, level = support_state(labels, smooth)
+    grounded = float(np.mean(part >= 0))
+    if grounded < MIN_GROUNDED:
+        # Our vocabulary has no jumps: feet found on the floor this rarely
+        # mean the floor height is wrong, and the supports would be invented.
+        warnings.warn(f"feet on the floor in only {100 * grounded:.0f} % of {T} frames (expected most of them; "
+                      "is the floor height right?): no support symbols written", stacklevel=3)
+        return []
+    w = max(3, int(round(0.3 * fps)) | 1)
+    code = _mode_filter((part + 1) * 4 + (level + 1), w)
+    min_len = max(1, int(round(MIN_SUPPORT_S * fps)))
+    runs = [r for r in _runs(code) if r[0] >= 4 and r[2] - r[1] + 1 >= min_len]  # grounded only
+    height = _body_height(smooth)
+    pelvis = joints[:, joint_index("pelvis")]
+    out = []
+    state = (0, LEVELS.index("middle"), "place")
+    # The run the next movement leaves (before the first: standing from frame 0).
+    prev_start, prev_end = 0, 0
+    for c, a, b in runs:
+        new_part, new_level = c // 4 - 1, c % 4 - 1
+        # A step needs a flight: a weight-bearing foot off the floor between
+        # the two runs (a swaying pelvis or a sliding fitted foot is no step).
+        feet = {0: (0, 1), 1: (0,), 2: (1,)}[new_part]
+        # Before the first grounded run nothing says where the feet were (a
+        # fit finding the floor late), so that run is never a step.
+        flew = bool(out) or prev_end > 0
+        flew = flew and any((~labels.supporting[prev_end : a + 1, f]).sum() >= 2 for f in feet)
+        direction = _step_direction(smooth, labels, prev_end, a, new_part, height) if flew else "place"
+        new = (new_part, new_level, direction)
+        if new[:2] == state[:2] and direction == "place":
+            prev_start, prev_end = a, b
+            continue
+        # Window: from the middle of the hold left to the middle of this one.
+        lo, hi = (prev_start + prev_end) // 2, min((a + b) // 2 + 1, T - 1)
+        win = _pelvis_window(pelvis, lo, prev_end, a, hi, fps)
+        if win is None:
+            # The pelvis did not move: contact flicker, not a support change.
+            continue
+        (t0, t1), = refine_times([win])
+        start = int(np.clip(round(t0 * fps), 0, T - 1))
+        end = int(np.clip(round(t1 * fps), start + 1, T - 1))
+        state = new
+        out.append(Movement(_SUPPORT_PARTS[new_part], start, end, max(t0, 0.0), t1, direction, LEVELS[new_level], 0))
+        prev_start, prev_end = a, b
+    return out
+
+
+def _pelvis_window(pelvis: np.ndarray, lo: int, a: int, b: int, hi: int, fps: float):
+    """``(t, p, t0, t1)`` for :func:`~.timing.refine_times`: the pelvis's
+    progress from its mean over [lo, a] to its mean over [b, hi] (the state
+    changes between frames a and b); None when it moves less than
+    :data:`MIN_PELVIS_M` or the window is too short."""
+    if hi - lo < 4:
+        return None
+    p0 = np.nanmean(pelvis[lo : a + 1], axis=0)
+    p1 = np.nanmean(pelvis[b : hi + 1], axis=0)
+    d = p1 - p0
+    n2 = float(d @ d)
+    if not n2 > MIN_PELVIS_M**2:
+        return None
+    prog = (pelvis[lo : hi + 1] - p0) @ d / n2
+    # The state changes somewhere mid-movement: start the fit from the
+    # middles of the half windows on either side of the change.
+    return np.arange(lo, hi + 1) / fps, prog, 0.5 * (lo + a) / fps, 0.5 * (b + hi) / fps
+
+
+def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None, knees=None):
+    """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements.
+
+    `knees` (T, 2), degrees: knee bends.  Knees that straighten exactly and
+    bend again at f (a kink, not a speed minimum: the bend cannot go below
+    0) mark the arrival at a straight-legged support between two others.
+    """
     down = labels.supporting.all(axis=1)
     n = speed.size
 
     def key(f: int, since: int) -> bool:
         if not down[f] or (on_grid is not None and not on_grid[f]):
             return False
+        if knees is not None and 0 < f < len(knees) - 1:
+            k = knees[f - 1 : f + 2]
+            if np.all(k[1] < 0.05) and np.all(k[0] > k[1] + 0.1) and np.all(k[2] > k[1] + 0.1):
+                return True
         # A deep local speed minimum in the interval just before or after f
         # (below a third of the peaks within a second on either side).
         w = 25

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+from fractions import Fraction as F
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from capture2notation.errors import CompareError
 from capture2notation.notation.model import Score, Symbol
 from capture2notation.quantise.agreement import (
+    at_tempo,
     compare_scores,
     normalise,
     score_differences,
@@ -83,3 +87,72 @@ def test_wrong_level_is_unmatched():
 def test_compare_needs_scores():
     with pytest.raises(CompareError, match="Score"):
         compare_scores(REF, "score.lab")
+
+
+def test_same_score_at_another_tempo_agrees_fully():
+    # Twice the tempo with every time doubled: the same movements at the same seconds.
+    fast = at_tempo(REF, 2 * REF.tempo)
+    assert fast.tempo == 120 and [s.start for s in fast.symbols] == [0, 0, 2, 2, 4]
+    a = compare_scores(REF, fast)
+    assert a.symbol_agreement == 1.0 and a.exact and a.median_start_error == 0.0 and a.unmatched == 0
+    assert a.tempo_ratio == 2
+    assert score_differences(REF, fast) == [] and score_differences(fast, REF) == []
+    # The same beats at another tempo are other seconds: a real difference.
+    same_beats = REF.replace(tempo=2 * REF.tempo)
+    b = compare_scores(REF, same_beats)
+    assert not b.exact and b.symbol_agreement < 1.0
+    # Start errors are in reference beats: the arm's second symbol (beat 2) sits at beat 1.
+    errs, missing = start_errors(REF, same_beats)
+    assert missing == 0 and sorted(errs.tolist()) == pytest.approx([0.5, 0.5, 1.0])
+
+
+_PARTS = ("right_arm", "left_arm", "head")
+_DIRS = ("forward", "right", "left", "back", "place")
+
+
+@st.composite
+def _scores(draw):
+    syms = []
+    for part in _PARTS:
+        t = F(0)
+        for _ in range(draw(st.integers(0, 4))):
+            t += F(draw(st.integers(0, 4)), 4)
+            dur = F(draw(st.integers(1, 8)), 4)
+            d = draw(st.sampled_from(_DIRS))
+            lv = draw(st.sampled_from(("high", "low") if d == "place" else ("high", "middle", "low")))
+            syms.append(Symbol(t, dur, part, d, lv))
+            t += dur
+    return Score(symbols=tuple(syms), tempo=draw(st.integers(40, 140)))
+
+
+@settings(max_examples=60, deadline=None)
+@given(score=_scores(), ratio=st.sampled_from([F(1, 2), F(2), F(3), F(3, 2), F(64, 106)]))
+def test_agreement_is_in_time_not_in_beats(score, ratio):
+    """Invariant: re-expressing a score at any tempo changes none of the figures."""
+    other = at_tempo(score, score.tempo * ratio)
+    assert at_tempo(other, score.tempo) == score  # exact fractions: a lossless round trip
+    a = compare_scores(score, other)
+    assert a.symbol_agreement == 1.0 and a.exact and a.tempo_ratio == ratio
+    assert a.unmatched == 0 and (a.matched == 0 or a.median_start_error == 0.0)
+    # Both directions sample the same seconds.
+    assert compare_scores(other, score).symbol_agreement == 1.0
+
+
+def test_agreement_samples_reference_beats():
+    """A candidate at twice the tempo with one symbol a candidate beat late is
+    half a reference beat late: it costs the reference-beat cells it covers."""
+    ref = Score(symbols=(Symbol(1, 1, "right_arm", "forward", "middle"), Symbol(3, 1, "right_arm", "right", "middle")),
+                tempo=60)
+    cand = Score(symbols=(Symbol(2, 2, "right_arm", "forward", "middle"), Symbol(6, 2, "right_arm", "right", "middle")),
+                 tempo=120)
+    assert compare_scores(ref, cand).exact
+    late = Score(symbols=(Symbol(3, 2, "right_arm", "forward", "middle"), Symbol(6, 2, "right_arm", "right", "middle")),
+                 tempo=120)
+    a = compare_scores(ref, late)
+    # Sampled at the centres of reference beats 0..3 (0.5, 1.5, …) the late
+    # start at 1.5 is in time; per half beat, the cell 1-1.5 differs.
+    assert a.symbol_agreement == 1.0 and not a.exact
+    assert compare_scores(ref, late, step=F(1, 2)).symbol_agreement == pytest.approx(7 / 8)
+    assert a.median_start_error == pytest.approx(0.25)  # median of 0.5 and 0 reference beats
+    with pytest.raises(CompareError, match="tempo"):
+        at_tempo(ref, 0)

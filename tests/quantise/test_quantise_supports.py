@@ -1,0 +1,105 @@
+"""Supports of noisy motion: contacts from smoothed joints, state changes, no symbols from jitter."""
+
+from __future__ import annotations
+
+import warnings
+from fractions import Fraction as F
+
+import numpy as np
+import pytest
+
+from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
+from capture2notation.effort.model import progress
+from capture2notation.quantise.agreement import normalise
+from capture2notation.quantise.labels import label_frames, with_supports
+from capture2notation.quantise.segment import segment_motion
+from capture2notation.quantise.supports import smooth_positions
+
+FPS = 25.0
+
+
+def _plie(tempo=60.0, start=1.0, dur=1.0, beats=4.0):
+    """Both feet down, a plié (knees 90°) from `start` over `dur` beats, then held."""
+    body = Body()
+    spb = 60.0 / tempo
+    T = int(round(beats * spb * FPS)) + 1
+    t = np.arange(T) / FPS
+    s = progress((t - start * spb) / (dur * spb), -2.5, 0.5)
+    s[t < start * spb] = 0.0
+    a = np.zeros((T, len(JOINTS), 3))
+    for side in ("right", "left"):
+        a[:, joint_index(f"{side}_hip"), 0] = np.radians(45) * s
+        a[:, joint_index(f"{side}_knee"), 0] = np.radians(-90) * s
+        a[:, joint_index(f"{side}_ankle"), 0] = np.radians(45) * s
+    leg = body.segment_length("right_hip", "right_knee") + body.segment_length("right_knee", "right_ankle")
+    root = np.tile(body.rest[0], (T, 1))
+    # Knees bent 90° with 45° at hip and ankle: the hip comes down so the feet stay flat.
+    root[:, 2] -= leg * (1 - np.cos(np.radians(45) * s))
+    return forward_kinematics(a, root)
+
+
+def _supports(score):
+    return [s for s in normalise(score).symbols if s.is_support]
+
+
+@pytest.mark.parametrize("sigma", [0.01, 0.02])
+def test_jitter_alone_writes_no_symbol(sigma):
+    """Standing still with 1-2 cm of jitter per coordinate: nothing moves, nothing is written."""
+    rng = np.random.default_rng(4)
+    still = forward_kinematics(np.zeros((150, len(JOINTS), 3)))
+    seg = segment_motion(still + rng.normal(0.0, sigma, still.shape), FPS, tempo=60)
+    assert normalise(seg.score).symbols == ()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_plie_with_jitter_is_one_support_symbol_on_the_grid(seed):
+    joints = _plie()
+    clean = segment_motion(joints, FPS, tempo=60).score
+    assert [(s.start, s.duration, s.part, s.level) for s in _supports(clean)] == [(1, 1, "support", "low")]
+    noisy = joints + np.random.default_rng(seed).normal(0.0, 0.01, joints.shape)
+    sup = _supports(segment_motion(noisy, FPS, tempo=60).score)
+    assert len(sup) == 1
+    (s,) = sup
+    assert (s.part, s.direction, s.level) == ("support", "place", "low")
+    assert abs(s.start - 1) <= F(1, 4) and abs(s.end - 2) <= F(1, 4)
+
+
+def test_feet_off_the_floor_write_no_supports_and_say_so():
+    """A floor 10 cm too low (as an unknown floor in a fit can be): no invented supports."""
+    rng = np.random.default_rng(2)
+    joints = _plie()
+    joints[..., 2] += 0.10
+    noisy = joints + rng.normal(0.0, 0.01, joints.shape)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        score = segment_motion(noisy, FPS, tempo=60).score
+    assert not _supports(score)
+    assert any("floor" in str(w.message) for w in caught)
+
+
+def test_smoothing_keeps_missing_samples_missing():
+    rng = np.random.default_rng(0)
+    j = forward_kinematics(np.zeros((40, len(JOINTS), 3))) + rng.normal(0.0, 0.01, (40, len(JOINTS), 3))
+    j[10:13, joint_index("right_wrist")] = np.nan
+    s = smooth_positions(j, FPS)
+    assert np.isnan(s[10:13, joint_index("right_wrist")]).all()
+    assert np.isfinite(np.delete(s, joint_index("right_wrist"), axis=1)).all()
+    # Smoothing removes most of the jitter of a still pose.
+    rest = forward_kinematics(np.zeros((1, len(JOINTS), 3)))[0]
+    ok = np.isfinite(s).all(axis=-1)
+    assert np.std((s - rest)[ok]) < 0.6 * np.std((j - rest)[np.isfinite(j).all(axis=-1)])
+    assert smooth_positions(j[:3], FPS) is not None and smooth_positions(j[:3], FPS).shape == (3, len(JOINTS), 3)
+
+
+def test_with_supports_rewrites_the_support_columns():
+    lab = label_frames(forward_kinematics(np.zeros((4, len(JOINTS), 3))), FPS)
+    sup = np.array([[True, True], [True, False], [False, False], [True, True]])
+    lev = np.array([[1, 1], [2, -1], [-1, -1], [0, 2]])
+    out = with_supports(lab, sup, lev)
+    c = {p: out.index(p) for p in ("support", "right_support", "left_support")}
+    assert out.level[:, c["support"]].tolist() == [1, -1, -1, -1]  # unequal levels at frame 3
+    assert out.level[:, c["right_support"]].tolist() == [1, 2, -1, 0]
+    assert out.direction[:, c["left_support"]].tolist()[2] == -1
+    assert out.support_level.tolist() == lev.tolist()
+    # Gesture columns untouched.
+    assert np.array_equal(out.direction[:, : c["support"]], lab.direction[:, : c["support"]])
