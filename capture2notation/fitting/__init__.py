@@ -6,7 +6,8 @@
 * :func:`fit_points3d` — measured 3D joints (BVH, Kinect) -> :class:`FitResult`;
 * :class:`FitOptions` — weights and iterations; :class:`PoseModel` — the
   solver's parametrisation, FK and Jacobian; :func:`estimate_offsets` —
-  per-clip segment lengths.
+  per-clip segment lengths; :func:`direction_spread` — how well each frame
+  determines each segment's direction.
 """
 
 from .camera import DEFAULT_DISTANCE, DEFAULT_HEIGHT, DEFAULT_HFOV_DEG, Camera
@@ -16,15 +17,17 @@ from .lengths import estimate_offsets
 from .model import PoseModel
 from .result import FitResult
 from .solver import FitOptions
+from .uncertainty import direction_spread
 
 __all__ = [
-    "Camera",
     "DEFAULT_DISTANCE",
     "DEFAULT_HEIGHT",
     "DEFAULT_HFOV_DEG",
+    "Camera",
     "FitOptions",
     "FitResult",
     "PoseModel",
+    "direction_spread",
     "estimate_offsets",
     "fit_keypoints",
     "fit_points3d",

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import FittingError
 
-__all__ = ["Camera", "DEFAULT_HFOV_DEG", "DEFAULT_DISTANCE", "DEFAULT_HEIGHT"]
+__all__ = ["DEFAULT_DISTANCE", "DEFAULT_HEIGHT", "DEFAULT_HFOV_DEG", "Camera"]
 
 #: Default horizontal field of view, degrees (a phone's main camera is 65-75°
 #: in landscape; rehearsal footage is often zoomed a little).
@@ -73,7 +73,7 @@ class Camera:
 
     @classmethod
     def default(cls, image_size, hfov_deg: float = DEFAULT_HFOV_DEG,
-                distance: float = DEFAULT_DISTANCE, height: float = DEFAULT_HEIGHT) -> "Camera":
+                distance: float = DEFAULT_DISTANCE, height: float = DEFAULT_HEIGHT) -> Camera:
         """Upright, level camera on +y looking at the origin (DESIGN.md's front view).
 
         Parameters
@@ -96,7 +96,7 @@ class Camera:
         return cls(K, R, -R @ centre, (w, h))
 
     @classmethod
-    def from_truth(cls, truth) -> "Camera":
+    def from_truth(cls, truth) -> Camera:
         """Camera of a truth sidecar (a ``Truth`` or a mapping with ``K``, ``R``, ``t``, ``image_size``)."""
         def get(name):
             if hasattr(truth, name):
@@ -108,7 +108,7 @@ class Camera:
 
         return cls(get("K"), get("R"), get("t"), tuple(int(v) for v in np.asarray(get("image_size")).tolist()))
 
-    def with_focal(self, f: float) -> "Camera":
+    def with_focal(self, f: float) -> Camera:
         """The same camera with focal length `f` pixels (both axes)."""
         K = self.K.copy()
         K[0, 0] = K[1, 1] = float(f)

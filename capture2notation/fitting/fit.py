@@ -8,7 +8,15 @@ Data terms (see :mod:`capture2notation.fitting.solver` for the solver):
 * world prior: the directions of segments measured by the keypoint model's
   world landmarks (camera-aligned axes), ``‖R d/|d| − u‖ / σ_dir`` — this is
   what resolves the depth ambiguity of a single view; the same landmarks give
-  the per-clip segment lengths.
+  the per-clip segment lengths (the pelvis → neck direction pulls little:
+  BlazePose leans the trunk 20–40° towards the camera);
+* floor (known camera only): the lowest foot point stands at its standing
+  height, z = 0 being the floor, which ties the figure's depth to where its
+  feet meet the floor in the image.
+
+Priors: joint limits, a pull of the trunk to upright, and temporal
+smoothness — loose and Jacobi-coupled in the main solve, then firm and exact
+for the root and legs (:mod:`~capture2notation.fitting.temporal`).
 
 Missing or low-confidence landmarks carry zero or small weight and lower the
 output confidence of the joints they measure; frames with too few landmarks
@@ -26,9 +34,21 @@ from .ik import initial_angles
 from .lengths import offsets_from_ratios
 from .model import PoseModel
 from .result import FitResult
-from .solver import FitOptions, Terms, check_fps, fill, fill2, pelvis_axis, rewarm, solve, to_result
+from .solver import (
+    FitOptions,
+    Terms,
+    check_fps,
+    fill,
+    fill2,
+    pelvis_axis,
+    rewarm,
+    solve,
+    to_result,
+)
+from .temporal import coupled_params, smooth_root
+from .uncertainty import direction_spread, spread_factor
 
-__all__ = ["fit_keypoints", "fit_track", "refine_focal", "TARGETS_2D"]
+__all__ = ["TARGETS_2D", "fit_keypoints", "fit_track", "refine_focal"]
 
 _J = len(JOINTS)
 
@@ -63,7 +83,7 @@ TARGETS_2D: tuple[tuple[str, tuple[int, ...], float], ...] = (
 
 #: Segments whose measured direction constrains depth (pairs of target names, weight).
 _DIRECTIONS: tuple[tuple[str, str, float], ...] = (
-    ("pelvis", "neck", 1.0),
+    ("pelvis", "neck", 0.2),  # BlazePose leans the trunk towards the camera: a hint only
     ("left_hip", "right_hip", 1.0),
     ("left_shoulder", "right_shoulder", 1.0),
     ("right_shoulder", "right_elbow", 1.0),
@@ -356,9 +376,14 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
             raise FittingError("fit_keypoints needs a camera or the image_size (width, height) for a default camera")
         camera = refine_focal(xy, conf, fps, Camera.default(image_size), world=world, body=body, options=opt)
     model, terms, (names, tx, tc, tw), use2 = _problem(xy, conf, world, body, camera, opt)
+    if not set_floor and opt.sigma_floor > 0:
+        _floor_terms(model, terms, tc, names)
     params0 = _initial_params(model, camera, names, tx, tc, tw)
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
     params, cost = rewarm(model, params, cost, terms, fps, opt)
+    for _ in range(opt.root_passes):
+        params = smooth_root(model, params, terms, fps, opt)
+        params, cost = solve(model, params, terms, fps, opt, opt.polish_iterations, frozen=coupled_params(model))
     usable = np.sum(tc[:, use2] >= opt.min_confidence, axis=1) >= opt.min_targets
     # Per-target fit quality from the remaining reprojection error (sigma units).
     pts = model.forward(params)
@@ -368,8 +393,33 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
     quality = np.ones_like(tc)
     quality[:, use2] = 1.0 / (1.0 + (np.nan_to_num(err, nan=np.inf) / 3.0) ** 2)
     target_conf = tc * quality
-    result = to_result(model, params, fps, times, _joint_confidence(names, target_conf), usable)
+    joint_conf = _joint_confidence(names, target_conf)
+    if opt.spread_deg > 0:
+        # A joint is only as sure as the direction of the segment it ends.
+        joint_conf *= spread_factor(direction_spread(model, params, terms, fps, opt), opt.spread_deg)
+    result = to_result(model, params, fps, times, joint_conf, usable)
     return _floored(result, model) if set_floor else result
+
+
+#: Model points that can touch the floor.
+_FOOT_POINTS = ("right_toe", "left_toe", "right_heel", "left_heel", "right_ankle", "left_ankle")
+
+
+def _floor_terms(model: PoseModel, terms: Terms, tc: np.ndarray, names) -> None:
+    """Add the floor-contact term to `terms` (known camera: the floor is z = 0).
+
+    A point's target is its height when standing flat on both feet, so flat
+    feet, relevé (toes) and plié all satisfy it.  Frames whose feet are not
+    seen get no floor term.
+    """
+    idx = np.array([model.index(n) for n in _FOOT_POINTS])
+    rest = model.forward(np.zeros((1, model.n_params)))[0]
+    body = model.body
+    lowest_rest = body.rest[[joint_index("right_toe"), joint_index("right_ankle")], 2].min()
+    terms.floor_idx = idx
+    terms.floor_z = rest[idx, 2] - rest[idx, 2].min() + lowest_rest
+    seen = tc[:, [names.index(n) for n in _FOOT_POINTS]].max(axis=1)
+    terms.floor_w = np.where(seen >= 0.5, 1.0, 0.0)
 
 
 def _joint_confidence(names, tconf) -> np.ndarray:

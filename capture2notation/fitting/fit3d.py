@@ -49,8 +49,9 @@ def fit_points3d(points, confidence, fps: float, body: Body | None = None, times
         Joints are the model's (per-clip segment lengths), consistent with
         the angles.
     """
-    # Positions constrain every segment directly: fewer iterations converge.
-    opt = options or FitOptions(iterations=12)
+    # Positions constrain every segment directly: fewer iterations converge,
+    # and the trunk's tilt is measured, so it needs no pull to upright.
+    opt = options or FitOptions(iterations=12, sigma_pelvis=4.0, sigma_trunk=4.0)
     check_fps(fps)
     body = body or Body()
     points = np.asarray(points, float)

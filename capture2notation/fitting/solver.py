@@ -29,7 +29,7 @@ from .camera import Camera
 from .model import PoseModel
 from .result import FitResult
 
-__all__ = ["FitOptions", "Terms", "solve", "rewarm", "to_result"]
+__all__ = ["FitOptions", "Terms", "rewarm", "solve", "to_result"]
 
 _J = len(JOINTS)
 
@@ -46,15 +46,53 @@ class FitOptions:
         Noise of a world-landmark segment direction (unit-vector difference).
     sigma_3d : float
         Noise of a 3D joint position, metres.
+    sigma_floor : float
+        Spread of the lowest foot point's height about its standing height,
+        metres, when the camera (hence the floor) is known; 0 switches the
+        floor term off.  Through a known camera the floor ties a standing
+        foot's depth to its image position, which the figure's image scale
+        alone does poorly.  It assumes some foot is down (Huber's loss lets
+        jumps go, at a cost): a figure floating above the floor is pulled
+        down.
     sigma_smooth : float
         Second-difference noise of an angle at 25 fps, radians (scaled by
-        ``25 / fps`` for other rates); root uses ``sigma_smooth`` metres.
+        ``25 / fps`` for other rates).
+    sigma_root_smooth : float
+        Second-difference noise of the root position at 25 fps, metres
+        (a pelvis accelerating at 3 m/s² moves 5 mm per frame²; the default
+        is looser, which kept more symbols on the whole path).  A single
+        view measures the performer's depth only through the figure's
+        image scale, so without this the depth wanders and standing feet
+        slide.
+    sigma_leg_smooth : float
+        The same for the pelvis, hip, knee and ankle angles, radians, in the
+        exact smoothing pass.  Firmer values (0.01–0.02) keep a standing
+        foot under DESIGN.md's 0.2 m/s support speed at a pixel of keypoint
+        noise, but smooth away the pauses that mark leg gestures: whole-path
+        symbol agreement through BlazePose fell by 4–7 points.
     sigma_rest, sigma_twist : float
         Spread of the pull to the rest pose for swings and for twists, radians.
+    sigma_pelvis, sigma_trunk : float
+        Spread of the pull of the pelvis, and of the waist and chest, to
+        upright (their tilts, not the turns), radians.  A single view
+        measures a trunk's tilt towards the camera poorly, and an unbounded
+        pelvis pitch otherwise trades off against the hips: BlazePose's world
+        landmarks lean the trunk 20–40° towards the camera in front views of
+        the virtual dancer.
     huber : float
         Huber threshold in units of sigma.
+    spread_deg : float
+        Angular spread of a segment's direction (Laplace approximation,
+        :mod:`~capture2notation.fitting.uncertainty`) that halves the
+        confidence of the joint ending it; 0 leaves confidence to the
+        landmarks and the reprojection error alone.
     iterations : int
         Levenberg–Marquardt iterations over all frames.
+    root_passes, polish_iterations : int
+        Passes of the exact smoothing of the root and legs
+        (:func:`~capture2notation.fitting.temporal.smooth_root`), each
+        followed by this many iterations of the other angles with those
+        held.
     min_targets : int
         Frames with fewer usable targets are returned as NaN.
     min_confidence : float
@@ -62,22 +100,35 @@ class FitOptions:
 
     Notes
     -----
-    Defaults were set on the built-in phrases rendered at 640×480
-    (``benchmarks/bench_fitting.py``): BlazePose's world landmarks give
-    forearm and shin directions 15–20° off while its image landmarks are
-    within 1–3°, so the world prior is kept loose (``sigma_dir``) and
-    mostly decides in front / behind; a firm twist prior biased rounded
-    arms by ~5°, so the rest-pose pull is only a tie-breaker.
+    Defaults were set on the built-in phrases and random scores rendered at
+    640×480 (``benchmarks/bench_fitting.py --labels``): BlazePose's world
+    landmarks give forearm and shin directions 15–20° off while its image
+    landmarks are within 1–3°, so the world prior is kept loose
+    (``sigma_dir``) and mostly decides in front / behind; a firm twist
+    prior biased rounded arms by ~5°, so the rest-pose pull is only a
+    tie-breaker.  The trunk priors cost ~3 mm MPJPE on clean keypoints
+    of a figure that sways its waist by ±17°.  Per-frame label agreement
+    through BlazePose is limited by its world landmarks, whose depth sign
+    is right for only 60–90 % of even strongly foreshortened segments on
+    these renders.
     """
 
     sigma_2d: float = 0.02
     sigma_dir: float = 0.18
     sigma_3d: float = 0.02
+    sigma_floor: float = 0.02
     sigma_smooth: float = 0.08
+    sigma_root_smooth: float = 0.02
+    sigma_leg_smooth: float = 0.08
     sigma_rest: float = 4.0
+    sigma_pelvis: float = 0.1
+    sigma_trunk: float = 0.2
     sigma_twist: float = 2.0
     huber: float = 2.0
+    spread_deg: float = 0.0
     iterations: int = 20
+    root_passes: int = 1
+    polish_iterations: int = 3
     min_targets: int = 6
     min_confidence: float = 0.1
 
@@ -96,6 +147,9 @@ class Terms:
     idx3: np.ndarray | None = None  # (N3,) point index of 3D targets
     obs3: np.ndarray | None = None  # (T, N3, 3)
     w3: np.ndarray | None = None  # (T, N3)
+    floor_idx: np.ndarray | None = None  # (F,) point index of the feet's lowest points
+    floor_z: np.ndarray | None = None  # (F,) their heights above the floor in a flat-footed stance, metres
+    floor_w: np.ndarray | None = None  # (T,)
 
 
 def _normal_equations(model: PoseModel, params, terms: Terms, opt: FitOptions, need_jac: bool):
@@ -153,6 +207,18 @@ def _normal_equations(model: PoseModel, params, terms: Terms, opt: FitOptions, n
             Jr = proj @ dd
         add(r, terms.wd, Jr)
 
+    if terms.floor_idx is not None:
+        # Some foot is on the floor: the lowest foot point (relative to its
+        # height when standing flat) sits at its standing height.  Huber's
+        # loss lets jumps go.
+        z = pts[:, terms.floor_idx, 2] - terms.floor_z
+        low = np.argmin(z, axis=1)
+        r = np.take_along_axis(z, low[:, None], axis=1)[..., None] / opt.sigma_floor  # (T, 1, 1)
+        Jr = None
+        if need_jac:
+            Jr = jac[np.arange(T), terms.floor_idx[low], 2][:, None, None, :] / opt.sigma_floor
+        add(r, terms.floor_w[:, None], Jr)
+
     if terms.idx3 is not None:
         r = (pts[:, terms.idx3] - np.nan_to_num(terms.obs3)) / opt.sigma_3d
         Jr = jac[:, terms.idx3] / opt.sigma_3d if need_jac else None
@@ -182,6 +248,9 @@ def _prior_precision(model: PoseModel, fps: float, opt: FitOptions, T: int):
     # Per-frame changes shrink with the frame rate; linear (not quadratic)
     # scaling keeps high-rate mocap from being over-smoothed.
     scale = 25.0 / fps if fps > 0 else 1.0
+    # The firm root and leg spreads act only in the exact pass
+    # (:mod:`~capture2notation.fitting.temporal`): Jacobi coupling at that
+    # weight would pin the trajectory to its start.
     smooth = np.full(n, 1.0 / (opt.sigma_smooth * scale) ** 2)
     if T == 1:
         smooth[:] = 0.0
@@ -189,7 +258,10 @@ def _prior_precision(model: PoseModel, fps: float, opt: FitOptions, T: int):
     rest[:3] = 0.0
     twist = (model.dof_axis == 2) & (model.dof_joint != 0)
     rest[3:][twist] = 1.0 / opt.sigma_twist**2
-    rest[3:][model.dof_joint == 0] = 0.0  # the pelvis orientation is free
+    # The pelvis may face any way, but it and the spine stay near upright.
+    rest[3:][model.dof_joint == 0] = np.where(model.dof_axis[model.dof_joint == 0] == 2, 0.0, 1.0 / opt.sigma_pelvis**2)
+    spine = np.isin(model.dof_joint, [JOINTS.index("waist"), JOINTS.index("chest")]) & (model.dof_axis != 2)
+    rest[3:][spine] = 1.0 / opt.sigma_trunk**2
     return smooth, rest
 
 
@@ -199,11 +271,11 @@ CHUNK, OVERLAP = 400, 16
 
 
 def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
-          iterations: int) -> tuple[np.ndarray, np.ndarray]:
+          iterations: int, frozen: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Solve long clips in overlapping chunks of :data:`CHUNK` frames; see :func:`solve_batch`."""
     T = params.shape[0]
     if T <= CHUNK:
-        return solve_batch(model, params, terms, fps, opt, iterations)
+        return solve_batch(model, params, terms, fps, opt, iterations, frozen)
     out = np.empty_like(params)
     cost = np.empty(T)
     start = 0
@@ -212,7 +284,7 @@ def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: F
         b = min(T, start + CHUNK)
         init = params[a:b].copy()
         init[: start - a] = out[a:start]  # warm start from the previous chunk
-        p, c = solve_batch(model, init, _subset(terms, slice(a, b)), fps, opt, iterations)
+        p, c = solve_batch(model, init, _subset(terms, slice(a, b)), fps, opt, iterations, frozen)
         # Keep the chunk's frames from `start` on; its first OVERLAP frames only
         # gave the temporal term context.
         out[start:b], cost[start:b] = p[start - a :], c[start - a :]
@@ -221,30 +293,38 @@ def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: F
 
 
 def solve_batch(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
-                iterations: int) -> tuple[np.ndarray, np.ndarray]:
+                iterations: int, frozen: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Vectorised Levenberg–Marquardt over all frames; returns (params, data cost per frame).
 
     The first two thirds of the iterations use a hundredth of the temporal
     weight, so frames converge on their own data first; Jacobi coupling with
     full weight would otherwise spread information one frame per iteration.
+    Parameters listed in `frozen` (indices into the parameter vector) are
+    held, and the temporal term has full weight from the start: the polish
+    after :func:`~capture2notation.fitting.temporal.smooth_root`.
     """
     T, n = params.shape
     smooth_full, rest = _prior_precision(model, fps, opt, T)
     mu = np.full(T, 1e-2)
     lower, upper = model.lower, model.upper
+    free = None if frozen is None else np.setdiff1d(np.arange(n), frozen)
 
     def total(p, ref, data):
         return data + 0.5 * np.sum(smooth * (p - ref) ** 2 + rest * p**2, axis=1)
 
     for it in range(iterations):
-        smooth = smooth_full * (0.01 if it < (2 * iterations) // 3 else 1.0)
+        smooth = smooth_full * (0.01 if it < (2 * iterations) // 3 and frozen is None else 1.0)
         ref = _temporal_ref(params)
         cost, H, g = _normal_equations(model, params, terms, opt, need_jac=True)
         H += np.diag(smooth + rest)
         g += smooth * (params - ref) + rest * params
         diag = np.einsum("tii->ti", H)
         A = H + (mu[:, None] * (diag + 1e-6))[:, :, None] * np.eye(n)
-        step = -np.linalg.solve(A, g[..., None])[..., 0]
+        if frozen is not None:
+            step = np.zeros_like(params)
+            step[:, free] = -np.linalg.solve(A[:, free][:, :, free], g[:, free, None])[..., 0]
+        else:
+            step = -np.linalg.solve(A, g[..., None])[..., 0]
         cand = np.clip(params + step, lower, upper)
         new = total(cand, ref, _normal_equations(model, cand, terms, opt, need_jac=False))
         better = new < total(params, ref, cost)
@@ -267,7 +347,7 @@ def rewarm(model, params, cost, terms, fps, opt, ratio=3.0, iterations=8):
 
 def _subset(terms: Terms, sl: slice) -> Terms:
     out = Terms(**terms.__dict__)
-    for k in ("obs2", "w2", "dirs", "wd", "obs3", "w3"):
+    for k in ("obs2", "w2", "dirs", "wd", "obs3", "w3", "floor_w"):
         v = getattr(terms, k)
         if v is not None:
             setattr(out, k, v[sl])

@@ -7,7 +7,13 @@ import pytest
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.errors import FittingError
-from capture2notation.fitting import Camera, FitResult, fit_keypoints, fit_points3d, fit_track
+from capture2notation.fitting import (
+    Camera,
+    FitResult,
+    fit_keypoints,
+    fit_points3d,
+    fit_track,
+)
 
 T = 40
 
@@ -87,7 +93,7 @@ def test_unknown_camera_uses_the_default_and_sets_the_floor(synth):
     cam = Camera.default((640, 480), hfov_deg=55.0)
     xy, conf, world, truth = synth.observe(ang, root, cam, body, noise_px=1.0)
     res = fit_keypoints(xy, conf, 25.0, world=world, image_size=(640, 480))
-    rel = lambda j: j - j[:, :1]  # noqa: E731 - root-relative pose
+    rel = lambda j: j - j[:, :1]
     assert _mpjpe(rel(res.joints), rel(truth)) < 0.04
     feet = [joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("ankle", "toe")]
     assert np.max(np.abs(res.joints[:, feet, 2] - truth[:, feet, 2])) < 0.02
