@@ -13,10 +13,12 @@
    ``estimate_effort`` plus ``write_effort`` with its plots.
 
 Wall-clock and CPU times are both printed: the machine may be shared.
+``--white`` times the independent-residual likelihood instead of the
+default AR(1) one (the figures before the AR(1) model).
 
 Usage::
 
-    /work/venv/bin/python benchmarks/bench_effort.py [--n 20] [--workers 2] [--capture DIR]
+    /work/venv/bin/python benchmarks/bench_effort.py [--n 20] [--workers 2] [--capture DIR] [--white]
 """
 
 from __future__ import annotations
@@ -54,7 +56,7 @@ def _joints(score):
     return interpret(score, fps=FPS).joints() if interpret is not None else arc_motion(score, FPS)
 
 
-def bench_posterior(n: int, seed: int = 0) -> None:
+def bench_posterior(n: int, seed: int = 0, ar1: bool = True) -> None:
     """Time `n` single-movement posteriors."""
     rng = np.random.default_rng(seed)
     symbols = tuple(
@@ -70,7 +72,7 @@ def bench_posterior(n: int, seed: int = 0) -> None:
     walls, cpus, conv, steps, taus = [], [], [], [], []
     for c in curves:
         w0, c0 = time.perf_counter(), time.process_time()
-        post = sample_posterior(c.tau, c.s, c.weight, rng=rng)
+        post = sample_posterior(c.tau, c.s, c.weight, rng=rng, ar1=ar1)
         walls.append(time.perf_counter() - w0)
         cpus.append(time.process_time() - c0)
         conv.append(post.converged)
@@ -84,7 +86,7 @@ def bench_posterior(n: int, seed: int = 0) -> None:
     print(f"    seconds per converged posterior: wall median {np.median(walls[ok]):.3f} s, "
           f"CPU median {np.median(cpus[ok]):.3f} s (aim <= 0.2 s)")
     w0, c0 = time.perf_counter(), time.process_time()
-    posts = sample_posteriors([(c.tau, c.s, c.weight, None) for c in curves], rng=rng)
+    posts = sample_posteriors([(c.tau, c.s, c.weight, None) for c in curves], rng=rng, ar1=ar1)
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
     n_ok = sum(p.converged for p in posts)
     print(f"  all {len(curves)} in one vectorised run: converged {n_ok}/{len(posts)}; "
@@ -104,14 +106,14 @@ def sixty_second_phrase(seed: int = 1, tempo: int = 60) -> Score:
     return Score(symbols=tuple(syms), tempo=Fraction(tempo), effort=Effort(time=-2.42, weight=0.6, space=0.0))
 
 
-def bench_phrase(workers: int, seed: int = 1) -> None:
+def bench_phrase(workers: int, seed: int = 1, ar1: bool = True) -> None:
     score = sixty_second_phrase(seed)
     joints = _joints(score)
     joints = joints + 0.005 * np.random.default_rng(seed).standard_normal(joints.shape)
     for w in sorted({1, workers}):
         w0, c0 = time.perf_counter(), time.process_time()
         ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        res = estimate_effort(joints, None, FPS, score, rng=seed, workers=w)
+        res = estimate_effort(joints, None, FPS, score, rng=seed, workers=w, sampler_kw={"ar1": ar1})
         wall = time.perf_counter() - w0
         ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         child_cpu = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
@@ -155,11 +157,12 @@ def main(argv=None):
     ap.add_argument("--n", type=int, default=20, help="Movement posteriors to time.")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--capture", help="A capture folder (capture.npz + score.lab) to time the Effort step on.")
+    ap.add_argument("--white", action="store_true", help="Independent residuals instead of AR(1).")
     a = ap.parse_args(argv)
     print(f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs'}; "
-          f"load average {os.getloadavg()[0]:.1f} (2 cores, shared)")
-    bench_posterior(a.n)
-    bench_phrase(a.workers)
+          f"residuals: {'white' if a.white else 'AR(1)'}; load average {os.getloadavg()[0]:.1f} (2 cores, shared)")
+    bench_posterior(a.n, ar1=not a.white)
+    bench_phrase(a.workers, ar1=not a.white)
     if a.capture:
         bench_capture(a.capture)
 

@@ -93,7 +93,7 @@ class EffortResult:
 
 
 def _effort_fields(post: Posterior, space: SpaceEstimate) -> dict:
-    return {
+    out = {
         "time": post.summary(0),
         "weight": post.summary(1),
         "space": {"median": space.median, "ci90": list(space.ci90)},
@@ -101,6 +101,12 @@ def _effort_fields(post: Posterior, space: SpaceEstimate) -> dict:
         "acceptance": post.acceptance,
         "converged": post.converged,
     }
+    if post.rho is not None:
+        # frame-to-frame correlation of the progress residuals (AR(1) model):
+        # near 0 for jitter, near 1 for smooth capture errors
+        lo, med, hi = np.percentile(post.rho, [5, 50, 95])
+        out["residual_rho"] = {"median": float(med), "ci90": [float(lo), float(hi)]}
+    return out
 
 
 def _movement_dict(m: MovementEffort) -> dict:

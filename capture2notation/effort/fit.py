@@ -249,11 +249,76 @@ def fit_logistic_many(datasets, iterations: int = 60, sd_floor_sigma: float = 1e
     return out
 
 
+#: Grid of the AR(1) correlation ρ over which the Space regression is
+#: marginalised (the uniform prior of :data:`.likelihood.RHO_RANGE`).
+_RHO_GRID = np.linspace(-0.5, 0.99, 60)
+
+
+def _ar1_regression(tau, x, y, w, column: int):
+    """Posterior mean and sd of one coefficient of ``y = x β + ε`` with AR(1) residuals.
+
+    ``√w_i ε_i`` is AR(1) along each run of increasing τ, with correlation
+    ``ρ^(Δτ/δ)`` between neighbours (δ the median step), σ unknown (prior
+    1/σ) and β flat; ρ is marginalised over :data:`_RHO_GRID` (uniform
+    prior): a mixture of the per-ρ Student posteriors, summarised by its
+    mean and standard deviation.
+
+    Parameters
+    ----------
+    tau, y, w : (N,) ndarray
+    x : (N, P) ndarray
+        Design matrix.
+    column : int
+        The coefficient reported.
+
+    Returns
+    -------
+    mean, sd : float
+    """
+    n, p = x.shape
+    step = np.diff(tau, prepend=-np.inf)
+    first = step <= 0
+    first[0] = True
+    delta = np.median(step[~first]) if np.any(~first) else 1.0
+    expo = np.where(first, 0.0, step / delta)
+    rho = _RHO_GRID[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):  # first frames are replaced below
+        phi = np.exp(expo[None, :] * np.log(np.abs(rho)))
+    phi = np.where(first[None, :], 0.0, np.where((rho < 0) & (np.round(expo) % 2 == 1), -phi, phi))  # (K, N)
+    c = 1.0 / np.sqrt(1.0 - phi * phi)
+    sw = np.sqrt(w)
+    xw, yw = x * sw[:, None], y * sw
+
+    def whiten(v):  # (N, ...) -> (K, N, ...): each row minus φ times the one before
+        prev = np.roll(v, 1, axis=0)
+        shape = (slice(None), slice(None)) + (None,) * (v.ndim - 1)
+        return c[shape] * (v[None] - phi[shape] * prev[None])
+
+    xt, yt = whiten(xw), whiten(yw)
+    gram = np.einsum("kni,knj->kij", xt, xt)
+    coef = np.linalg.solve(gram, np.einsum("kni,kn->ki", xt, yt)[..., None])[..., 0]
+    rss = np.maximum(np.sum((yt - np.einsum("kni,ki->kn", xt, coef)) ** 2, axis=1), 1e-300)
+    dof = max(n - p, 1)
+    _, logdet = np.linalg.slogdet(gram)
+    # log p(y | ρ) with β and ln σ integrated out, up to a constant
+    logp = -0.5 * logdet - 0.5 * dof * np.log(rss) - 0.5 * np.sum(np.log(1.0 - phi * phi), axis=1)
+    post = np.exp(logp - logp.max())
+    post /= post.sum()
+    mean_k = coef[:, column]
+    # the Student posterior's variance (dof > 2), else the Gaussian's
+    var_k = rss / dof * np.linalg.inv(gram)[:, column, column] * (dof / (dof - 2.0) if dof > 2 else 1.0)
+    mean = float(post @ mean_k)
+    return mean, float(np.sqrt(post @ (var_k + (mean_k - mean) ** 2)))
+
+
 def fit_space(tau, radial, weight=None) -> SpaceEstimate:
     """Space from the radial deviation: ``radial ≈ c0 + c1·τ + A·sin(πτ)``, ``S = 1 − |A| / 0.1``.
 
     Eq. 5.5 pulls the extremity inward by ``(1 − S)·0.1·r·sin(πτ)``, so a
     direct movement (S = 1) has A = 0 and the most indirect one A = −0.1.
+    The residuals are AR(1) along each run of increasing τ, as in the
+    logistic's likelihood (:mod:`.likelihood`); their correlation ρ is
+    marginalised on a grid (:func:`_ar1_regression`).
     The straight-line terms absorb errors of the direct path's end radii.
     The uniform prior on S ∈ [0, 1] truncates the Gaussian posterior of A;
     an outward bulge (A > 0) is read by its size, as indirect as an inward
@@ -270,15 +335,10 @@ def fit_space(tau, radial, weight=None) -> SpaceEstimate:
     if tau.size < 4:
         raise EffortError(f"need at least 4 samples to fit Space, got {tau.size}")
     x = np.column_stack([np.ones_like(tau), tau, np.sin(np.pi * tau)])
-    sw = np.sqrt(w)
-    coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
-    resid = y - x @ coef
-    s2 = np.sum(w * resid**2) / max(tau.size - 3, 1)
-    cov = np.linalg.pinv((x * w[:, None]).T @ x)
-    amp = float(coef[2])
+    amp, se = _ar1_regression(tau, x, y, w, 2)
     # floor: the dancer's own modulation is resolved to ~1e-3 of the radius
     # (S to 0.01); a noise-free render would otherwise give a zero-width interval
-    se = float(max(np.sqrt(s2 * cov[2, 2]), 1e-3))
+    se = float(max(se, 1e-3))
     # inward (eq. 5.5) is the model; a clear outward bulge (eq. 5.6, bent
     # limbs) is read by its depth, but noise about zero stays signed so that
     # a direct movement is not pushed below S = 1

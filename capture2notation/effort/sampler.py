@@ -29,7 +29,6 @@ import numpy as np
 
 from ..errors import EffortError
 from .likelihood import Batch
-from .model import TIME_RANGE, WEIGHT_RANGE
 
 __all__ = ["N_TAU", "Chain", "GroupedDEMove", "integrated_time", "run_groups"]
 
@@ -144,10 +143,10 @@ class Chain:
 
     Attributes
     ----------
-    chain : (steps, W, 2) ndarray
-        (b, x0) of every walker at every step.
-    tau : (2,) ndarray
-        Integrated autocorrelation time of b and x0, steps.
+    chain : (steps, W, ndim) ndarray
+        θ = (b, x0[, ρ]) of every walker at every step.
+    tau : (ndim,) ndarray
+        Integrated autocorrelation time of each parameter, steps.
     acceptance : float
         Mean acceptance fraction of the group's walkers.
     converged : bool
@@ -163,21 +162,20 @@ class Chain:
         return int(self.chain.shape[0])
 
     def samples(self) -> np.ndarray:
-        """(M, 2) after burn-in 2·max τ and thinning by min τ / 2 (emcee's tutorial)."""
+        """(M, ndim) after burn-in 2·max τ and thinning by min τ / 2 (emcee's tutorial)."""
         tau = self.tau[np.isfinite(self.tau) & (self.tau > 0)]
         tmax = float(tau.max()) if tau.size else self.steps / N_TAU
         tmin = float(tau.min()) if tau.size else 1.0
         burn = min(int(2 * tmax), self.steps // 2)
         thin = max(1, int(0.5 * tmin))
-        return self.chain[burn::thin].reshape(-1, 2)
+        return self.chain[burn::thin].reshape(-1, self.chain.shape[-1])
 
 
-def _walker_ball(start, ball, nwalkers, rng):
-    """(W, 2) walkers around `start` with per-parameter sd `ball`, inside the prior box."""
-    p = start + ball * rng.standard_normal((nwalkers, 2))
-    p[:, 0] = np.clip(p[:, 0], TIME_RANGE[0] + 1e-3, TIME_RANGE[1] - 1e-3)
-    p[:, 1] = np.clip(p[:, 1], WEIGHT_RANGE[0] + 1e-4, WEIGHT_RANGE[1] - 1e-4)
-    return p
+def _walker_ball(start, ball, nwalkers, rng, bounds):
+    """(W, ndim) walkers around `start` with per-parameter sd `ball`, inside the prior box (ndim, 2)."""
+    p = start + ball * rng.standard_normal((nwalkers, start.size))
+    margin = 1e-4 * (bounds[:, 1] - bounds[:, 0])
+    return np.clip(p, bounds[:, 0] + margin, bounds[:, 1] - margin)
 
 
 def run_groups(
@@ -195,7 +193,7 @@ def run_groups(
     Parameters
     ----------
     batch : Batch
-    starts, balls : (G, 2) array_like
+    starts, balls : (G, batch.ndim) array_like
         Centre and per-parameter sd of each group's starting ball.
     rng : numpy.random.Generator
         Source of every draw (balls and emcee's moves).
@@ -213,13 +211,13 @@ def run_groups(
     list of Chain
         One per group, in order.
     """
-    G, W = batch.n_groups, int(nwalkers)
+    G, W, D = batch.n_groups, int(nwalkers), batch.ndim
     starts, balls = np.asarray(starts, dtype=float), np.asarray(balls, dtype=float)
-    if starts.shape != (G, 2) or balls.shape != (G, 2):
-        raise EffortError(f"starts and balls must be ({G}, 2), got {starts.shape} and {balls.shape}")
+    if starts.shape != (G, D) or balls.shape != (G, D):
+        raise EffortError(f"starts and balls must be ({G}, {D}), got {starts.shape} and {balls.shape}")
     if block < 1 or max_steps < 1:
         raise EffortError(f"block and max_steps must be >= 1, got {block} and {max_steps}")
-    coords = np.concatenate([_walker_ball(starts[g], balls[g], W, rng) for g in range(G)])
+    coords = np.concatenate([_walker_ball(starts[g], balls[g], W, rng, batch.bounds) for g in range(G)])
     logp = batch.log_marginal(coords)
     bad = ~np.isfinite(logp)
     if bad.any():
@@ -231,20 +229,20 @@ def run_groups(
         for i in np.flatnonzero(bad):
             g = i // W
             j = g * W + int(rng.choice(np.flatnonzero(ok[g])))
-            coords[i] = coords[j] * (1.0 + 1e-6 * rng.standard_normal(2))
+            coords[i] = coords[j] * (1.0 + 1e-6 * rng.standard_normal(D))
         logp = batch.log_marginal(coords)
     random = np.random.RandomState(int(rng.integers(2**32)))
     active = list(range(G))
     pieces: dict[int, list] = {g: [] for g in active}
     accepted = np.zeros(G)
-    old_tau = np.full((G, 2), np.inf)
+    old_tau = np.full((G, D), np.inf)
     result: dict[int, Chain] = {}
     steps = 0
     while active:
         n_a = len(active)
         run = min(block, max_steps - steps)
         sampler = emcee.EnsembleSampler(
-            n_a * W, 2, functools.partial(batch.log_marginal, groups=tuple(active)), vectorize=True,
+            n_a * W, D, functools.partial(batch.log_marginal, groups=tuple(active)), vectorize=True,
             moves=GroupedDEMove(n_a, W),
         )
         sampler.random_state = random.get_state()
@@ -252,12 +250,12 @@ def run_groups(
                                  skip_initial_state_check=True)
         random.set_state(sampler.random_state)
         steps += run
-        blk = sampler.get_chain().reshape(run, n_a, W, 2)
+        blk = sampler.get_chain().reshape(run, n_a, W, D)
         acc = sampler.backend.accepted.reshape(n_a, W).sum(axis=1)
         for j, g in enumerate(active):
             pieces[g].append(blk[:, j])
             accepted[g] += acc[j]
-        chains = np.stack([np.concatenate(pieces[g]) for g in active], axis=1)  # (steps, n_a, W, 2)
+        chains = np.stack([np.concatenate(pieces[g]) for g in active], axis=1)  # (steps, n_a, W, D)
         tau = integrated_time(chains)
         with np.errstate(invalid="ignore"):
             ok = (
@@ -272,7 +270,7 @@ def run_groups(
             del pieces[g]
         old_tau[active] = tau
         keep = np.flatnonzero(~finished)
-        coords = state.coords.reshape(n_a, W, 2)[keep].reshape(-1, 2)
+        coords = state.coords.reshape(n_a, W, D)[keep].reshape(-1, D)
         logp = state.log_prob.reshape(n_a, W)[keep].ravel()
         active = [active[j] for j in keep]
     return [result[g] for g in range(G)]

@@ -53,6 +53,8 @@ def test_effort_json_has_the_issue_fields(angry, tmp_path):
         assert FIELDS <= set(m)
         assert m["time"]["ci90"][0] <= m["time"]["median"] <= m["time"]["ci90"][1]
         assert 0 <= m["space"]["ci90"][0] <= m["space"]["ci90"][1] <= 1
+        # AR(1) residual correlation: 4 mm joint noise is white
+        assert -0.5 <= m["residual_rho"]["ci90"][0] < 0.0 < m["residual_rho"]["ci90"][1] <= 0.99
     assert FIELDS - {"part", "start", "duration"} | {"tempo"} <= set(data["pooled"])
     assert set(data["emotion"]) == {"happy", "sad", "angry", "afraid"}
     for key in ("progress", "pooled"):
