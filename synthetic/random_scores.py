@@ -25,7 +25,8 @@ exactly.  Guarantees (each is checked by ``tests/synthetic``):
 
 Supports follow a dancer's logic: both feet (plié, middle, relevé), a
 weight transfer onto one foot followed by gestures of the free leg and a
-closing onto both feet, or a step (``right_support forward middle`` …).
+closing onto both feet (after a step onto that foot, a change of level
+there: the weight is on it already), or a step (``right_support forward middle`` …).
 A change of support level takes at least :data:`LEVEL_CHANGE_S` seconds (a
 heel moving faster does not read as supporting), and the foot that has
 just landed from a step or a closing keeps the weight for the next symbol
@@ -275,6 +276,10 @@ def _legs_track(rng, n_beats, bpm):
             if not gestures:
                 return out
             level = ("low", "middle", "high")[int(rng.integers(3))]
+            if released is not None and level == "middle":
+                # Just stepped onto `foot` (at middle level): the weight is
+                # there already, so a middle support would show nothing.
+                level = ("low", "high")[int(rng.integers(2))]
             out.append(Symbol(t, dur, f"{foot}_support", "place", level))
             out += gestures
             out.append(Symbol(g_t, close, "support", "place", "middle"))

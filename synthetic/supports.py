@@ -8,8 +8,10 @@ raised, the body rises); a direction other than place is a step of
 end of each support symbol the pelvis is over the mean of the weight-bearing
 feet and as high as their levels allow, so the supporting feet stay on the
 floor; a foot whose support ended is free as soon as a gesture of its leg
-starts.  A gesturing foot never goes below the floor (the knee bends and the
-foot flexes instead).
+starts.  A foot that steps on the frame it lands (or on the first frame)
+stays on the floor one frame more, so its landing is seen as a support.
+A gesturing foot never goes below the floor (the knee bends and the foot
+flexes instead).
 
 :class:`Support` plans the root (pelvis) trajectory and the world targets of
 both ankles; :func:`leg_tracks` turns them, and the leg gestures, into
@@ -146,6 +148,12 @@ class Support:
         self.landing = {f: np.zeros(T, bool) for f in ("right", "left")}
         self._plan(score)
 
+    def _just_landed(self, foot: str, f0: int) -> bool:
+        """Whether `foot` comes down onto the floor at frame `f0` (or `f0` is the first frame)."""
+        if f0 == 0:
+            return True
+        return bool(self.landing[foot][f0]) or self.ankle[foot][f0 - 1, 2] > self.ankle[foot][f0, 2] + 1e-9
+
     def _leg_length(self, level):
         limb = self.limbs["right"]
         return float(limb.radius(np.radians(PLIE_BEND_DEG) if level == "low" else 0.0))
@@ -189,10 +197,20 @@ class Support:
                 za, zb = self.ankle[foot][f0, 2], self.level_z[s.level]
                 pa, pb = self.pitch[foot][f0], self.level_pitch[s.level]
                 a = self.ankle[foot]
-                a[n, :2] = base + sf[:, None] * (target - base)
+                sf_foot, lift_foot = sf, lift
+                if s.direction != "place" and planted and self._just_landed(foot, f0) and f1 - f0 > 1:
+                    # A foot that arrives on the floor at f0 (or stands on the
+                    # first frame, whose incoming speed is unknown) rests one
+                    # frame before it steps: a foot lifted again on its
+                    # landing frame is never still on the floor, so the
+                    # support it landed for would never be seen.
+                    tau1 = (n - f0 - 1) / (f1 - f0 - 1)
+                    sf_foot = np.where(tau1 > 0, progress(np.maximum(tau1, 1e-9), self.eff.time, self.eff.weight), 0.0)
+                    lift_foot = foot_lift(tau1, (f1 - f0 - 1) / self.fps, STEP_LIFT * body.height)
+                a[n, :2] = base + sf_foot[:, None] * (target - base)
                 a[n, 2] = za + sf * (zb - za)
                 if s.direction != "place" and planted:
-                    a[n, 2] += lift
+                    a[n, 2] += lift_foot
                 self.pitch[foot][n] = pa + sf * (pb - pa)
                 if not planted:
                     # Landing from a gesture: :func:`leg_tracks` blends the

@@ -31,6 +31,7 @@ __all__ = [
     "PLIE_DEG",
     "RELEVE_DEG",
     "FrameLabels",
+    "flat_foot_pitch",
     "label_frames",
     "support_frames",
     "with_supports",
@@ -106,7 +107,46 @@ def _rest_foot_pitch_deg(body: Body) -> float:
     return float(np.degrees(np.arctan2(-d[2], np.hypot(d[0], d[1]))))
 
 
-def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def flat_foot_pitch(joints: np.ndarray, contact: np.ndarray) -> np.ndarray:
+    """Pitch of each foot when flat on the floor, measured from the motion itself, degrees.
+
+    A fitted foot seen from the front is pitched 10-20° further down than
+    the body model's rest pose (its depth is barely observable), which
+    read every standing frame of a capture as relevé.  A flat foot is the
+    least pitched of a foot's contacts (a relevé only raises the heel), and
+    every phrase starts standing flat (DESIGN.md), so the lower decile of
+    the pitch over the frames in contact is the foot's own flat pitch.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joints, metres, z up.
+    contact : (T, 2) ndarray of bool
+        Right, left foot on the floor.
+
+    Returns
+    -------
+    (2,) ndarray
+        Right, left; the rest pitch of :class:`~capture2notation.body.Body`
+        for a foot never in contact.
+    """
+    out = np.full(2, _rest_foot_pitch_deg(Body()))
+    for k, side in enumerate(_SIDES):
+        p = _foot_pitch_deg(joints, side)[np.asarray(contact)[:, k]]
+        p = p[np.isfinite(p)]
+        if p.size:
+            out[k] = float(np.percentile(p, 10))
+    return out
+
+
+def _foot_pitch_deg(joints: np.ndarray, side: str) -> np.ndarray:
+    """(T,) pitch of ankle → toe below horizontal, degrees."""
+    d = joints[:, joint_index(f"{side}_toe")] - joints[:, joint_index(f"{side}_ankle")]
+    return np.degrees(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
+
+
+def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0,
+                   flat_pitch=None) -> tuple[np.ndarray, np.ndarray]:
     """Which feet support, and at which level, at every frame.
 
     Parameters
@@ -117,6 +157,10 @@ def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> tuple[
         Frames per second (for the foot speed).
     floor : float
         Floor height, metres.
+    flat_pitch : (2,) array_like, optional
+        Pitch (degrees) of the right and left foot standing flat, e.g. from
+        :func:`flat_foot_pitch`; the body model's rest pitch by default.
+        The heel is raised when a foot pitches :data:`RELEVE_DEG` beyond it.
 
     Returns
     -------
@@ -129,7 +173,7 @@ def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> tuple[
     T = joints.shape[0]
     supporting = np.zeros((T, 2), bool)
     level = np.full((T, 2), -1, int)
-    rest_pitch = _rest_foot_pitch_deg(Body())
+    flat = np.full(2, _rest_foot_pitch_deg(Body())) if flat_pitch is None else np.asarray(flat_pitch, float)
     for k, side in enumerate(_SIDES):
         ankle = joints[:, joint_index(f"{side}_ankle")]
         toe = joints[:, joint_index(f"{side}_toe")]
@@ -153,10 +197,9 @@ def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> tuple[
         knee_bend = bend_angle(
             joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")], ankle
         )
-        d = toe - ankle
-        pitch = np.degrees(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
+        pitch = _foot_pitch_deg(joints, side)
         lev = np.full(T, MIDDLE)
-        lev = np.where(pitch > rest_pitch + RELEVE_DEG, LEVELS.index("high"), lev)
+        lev = np.where(pitch > flat[k] + RELEVE_DEG, LEVELS.index("high"), lev)
         lev = np.where(knee_bend > PLIE_DEG, LEVELS.index("low"), lev)
         supporting[:, k] = sup
         level[:, k] = np.where(sup, lev, -1)

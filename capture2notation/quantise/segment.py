@@ -25,8 +25,9 @@ Noisy motion (fitted, mocap)
     ``split_ratio``, must move ``min_amplitude_deg``.  Its start and arrival
     are those of the Effort logistic fitted to its raw progress
     (:mod:`.timing`) — a speed threshold cuts a fifth to a third off each
-    end — and it must last :data:`_MIN_MOVE_S` (quicker swings are glitches
-    of the fit); its label is the mean pose over up to :data:`_HOLD_S` of
+    end — and it must last :data:`_MIN_MOVE_S` or hold its arrival pose for
+    :data:`_HOLD_S` (quicker swings that do not hold are glitches of the
+    fit); its label is the mean pose over up to :data:`_HOLD_S` of
     the hold after the arrival, and it is written only when that label
     differs from the part's previous one.  Key times of different parts
     within ``merge_window_s`` are pulled together.  Feet contacts come from
@@ -61,7 +62,7 @@ from scipy.signal import savgol_filter
 from ..errors import QuantiseError
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
-from .labels import DIRECTION_NAMES, FrameLabels, label_frames, support_frames, with_supports
+from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .spans import _ZERO_SPEED, movement_spans
 from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
 from .tempo import estimate_tempo, snap
@@ -304,7 +305,12 @@ def segment_motion(
         # Jitter of a centimetre is 0.5 m/s frame to frame: feet would never
         # be "slower than 0.2 m/s" (DESIGN.md).  Contacts come from smoothed
         # joints, for the supports and for the legs alike.
-        labels = with_supports(labels, *support_frames(smooth_positions(joints, fps), fps, floor))
+        smoothed = smooth_positions(joints, fps)
+        contact, _ = support_frames(smoothed, fps, floor)
+        # Measured feet carry a pitch bias of their own: relevé is a heel
+        # raised from the capture's own flat foot, not from the model's.
+        flat = flat_foot_pitch(smoothed, contact) if measured else None
+        labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat))
     estimated = tempo is None
     moves = None
     if estimated:
@@ -571,9 +577,11 @@ def _gesture_movements(
                 # Noisy motion: the logistic's start and arrival, and the pose
                 # averaged over the hold that follows the arrival.
                 t0, t1 = _fitted_times(raw_u, raw_x, spans, i, fps, t0, t1)
-                if t1 - t0 < _MIN_MOVE_S:
+                if t1 - t0 < _MIN_MOVE_S and nxt - (b + 1) < hold:
                     # A limb does not swing tens of degrees in a few frames
-                    # and back: a glitch of the measurement.
+                    # and back: a glitch of the measurement.  A quick
+                    # movement that arrives and holds its pose is a movement
+                    # (half a beat at 96 bpm is fitted as quick as 0.17 s).
                     continue
                 end_f = min(max(int(round(t1 * fps)), start_f + 1), T - 1)
                 frames = slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))

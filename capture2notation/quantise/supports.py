@@ -11,9 +11,12 @@ raised; the lower of two unequal levels).
 
 Support movements are found like gestures (:func:`~.segment.movement_spans`)
 on a "support speed": the pelvis's speed in leg lengths (expressed in
-degrees per second, as an angle seen from the foot) plus the knee-bend and
-foot-pitch speeds of the feet in contact.  Each movement whose end state
-differs from the state before it becomes one symbol; its direction is
+degrees per second, as an angle seen from the foot) plus the hip-ankle
+length and foot-pitch speeds of the weight-bearing feet.  Back-to-back
+support movements part at grid frames where both feet are down and the
+speed has a deep minimum, or where a foot lands (a step or a closing
+arrives when its foot comes down, even with the other foot free).  Each
+movement whose end state differs from the state before it becomes one symbol; its direction is
 ``place`` unless a weight-bearing foot travelled more than half a step
 (0.09 body heights) from under its hip — then the sector of that travel in
 the body frame (a step).
@@ -101,16 +104,26 @@ def _support_speed(labels: FrameLabels, joints: np.ndarray, fps: float) -> np.nd
     )
     pelvis = joints[:, joint_index("pelvis")] / max(float(leg), 1e-6)
     sig = [np.degrees(pelvis)]
+    # Only the feet that carry the weight: a foot still on the floor as its
+    # leg starts a gesture (or after the weight has left it) moves with the
+    # free leg, not with the supporting system.
+    bearing = weight_bearing(joints, labels.supporting)
     for k, side in enumerate(("right", "left")):
-        knee = bend_angle(
-            joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")], joints[:, joint_index(f"{side}_ankle")]
-        )
+        # The hip-ankle distance, not the knee angle: the angle of a knee
+        # straightening grows like the square root of the leg's shortening,
+        # so its speed is unbounded at the start and end of every transfer
+        # or rise and would hide the arrivals (and make false minima).
+        reach = np.degrees(np.linalg.norm(
+            joints[:, joint_index(f"{side}_hip")] - joints[:, joint_index(f"{side}_ankle")], axis=-1) / max(float(leg), 1e-6))
         d = joints[:, joint_index(f"{side}_toe")] - joints[:, joint_index(f"{side}_ankle")]
         pitch = np.degrees(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
-        c = labels.supporting[:, k]
-        sig.append(np.stack([np.where(c, knee, 0.0), np.where(c, pitch, 0.0)], axis=1))
-    x = np.concatenate(sig, axis=1)
-    return np.linalg.norm(np.diff(x, axis=0), axis=1) * fps
+        c = bearing[:, k]
+        # Only over intervals the foot supports at both ends: a foot that
+        # lands or lifts is no jump of the supporting system.
+        both = c[1:] & c[:-1]
+        sig.append(np.where(both[:, None], np.diff(np.stack([reach, pitch], axis=1), axis=0), 0.0))
+    x = np.concatenate([np.diff(sig[0], axis=0)] + sig[1:], axis=1)
+    return np.linalg.norm(x, axis=1) * fps
 
 
 def smooth_positions(joints: np.ndarray, fps: float, window_s: float = 0.3) -> np.ndarray:
@@ -199,7 +212,7 @@ def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, param
     # local minimum (never mid-step, while a foot is in the air).
     knees = np.stack([bend_angle(joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")],
                                  joints[:, joint_index(f"{side}_ankle")]) for side in ("right", "left")], axis=1)
-    spans = spans_fn(speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees))
+    spans = spans_fn(speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps))
     height = _body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
     out = []
@@ -330,26 +343,40 @@ def _pelvis_window(pelvis: np.ndarray, lo: int, a: int, b: int, hi: int, fps: fl
     return np.arange(lo, hi + 1) / fps, prog, 0.5 * (lo + a) / fps, 0.5 * (b + hi) / fps
 
 
-def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None, knees=None):
+def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None, knees=None,
+                    fps: float = 25.0):
     """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements.
 
+    Either a foot lands at f (it supports at f and did not at f - 1), or
+    both feet are down and the speed has a deep local minimum there.
     `knees` (T, 2), degrees: knee bends.  Knees that straighten exactly and
     bend again at f (a kink, not a speed minimum: the bend cannot go below
     0) mark the arrival at a straight-legged support between two others.
     """
-    down = labels.supporting.all(axis=1)
+    sup = labels.supporting
+    down = sup.all(axis=1)
+    # A foot that lands at f (a step, a closing) arrives there, whatever the
+    # other foot does: after a step onto one foot the other is free.
+    landed = np.zeros(len(sup), bool)
+    landed[1:] = (sup[1:] & ~sup[:-1]).any(axis=1)
     n = speed.size
 
     def key(f: int, since: int) -> bool:
-        if not down[f] or (on_grid is not None and not on_grid[f]):
+        if on_grid is not None and not on_grid[f]:
+            return False
+        if landed[f]:
+            return True
+        if not down[f]:
             return False
         if knees is not None and 0 < f < len(knees) - 1:
             k = knees[f - 1 : f + 2]
             if np.all(k[1] < 0.05) and np.all(k[0] > k[1] + 0.1) and np.all(k[2] > k[1] + 0.1):
                 return True
         # A deep local speed minimum in the interval just before or after f
-        # (below a third of the peaks within a second on either side).
-        w = 25
+        # (below a third of the peaks within two seconds on either side:
+        # a slow plié peaks early and arrives slowly, over a second before
+        # its end).
+        w = max(2, int(round(2.0 * fps)))
         for m in (f - 1, f):
             if 0 < m < n - 1 and speed[m] <= speed[m - 1] and speed[m] <= speed[m + 1]:
                 left, right = speed[max(0, m - w) : m].max(), speed[m + 1 : m + 1 + w].max()

@@ -36,19 +36,12 @@ def test_figure7_captures_exactly():
     assert score_differences(score, _capture(score).score) == []
 
 
-def test_leg_phrase_captures_what_the_dancer_performs():
-    """Plié, rise and relevé back to back: the knees straighten exactly at
-    each arrival and bend again (a kink, not a speed minimum) and must still
-    part the supports.  Known differences are the dancer's: the free foot
-    leaves the floor before the weight transfer (beat 8) has arrived, and the
-    step forward (beat 12) runs into the closing."""
+def test_leg_phrase_captures_exactly():
+    """Plié, rise and relevé back to back (the knees straighten exactly at
+    each arrival and bend again: a kink, not a speed minimum, must still part
+    the supports), a transfer onto one foot, a gesture, a close, a step."""
     score = phrases.phrase("leg_phrase")
-    capture = _capture(score).score
-    a = compare_scores(score, capture)
-    assert a.symbol_agreement >= 0.95
-    assert a.unmatched == 0 and a.median_start_error == 0.0
-    got = {(s.start, s.part, s.level) for s in capture.symbols if s.is_support}
-    assert {(0, "support", "low"), (2, "support", "middle"), (4, "support", "high"), (6, "support", "middle")} <= got
+    assert score_differences(score, _capture(score).score) == []
 
 
 @pytest.mark.parametrize("parts,split", [(("right_arm", "left_arm"), False), (("right_arm", "left_arm", "head"), False),

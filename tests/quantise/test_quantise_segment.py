@@ -9,7 +9,7 @@ import pytest
 
 from capture2notation.body import Body
 from capture2notation.errors import QuantiseError
-from capture2notation.notation.model import Score, Symbol
+from capture2notation.notation.model import LEVELS, Score, Symbol
 from capture2notation.quantise.agreement import compare_scores, score_differences
 from capture2notation.quantise.segment import SegmentParams, segment, segment_motion
 from capture2notation.quantise.spans import movement_spans
@@ -176,3 +176,86 @@ def test_smooth_measured_motion_is_not_taken_for_the_dancer_truth():
     assert not _has_exact_holds(label_frames(smooth, 25.0), smooth)
     a = compare_scores(EXPECTED, _gestures(segment_motion(smooth, 25.0, tempo=TEMPO).score))
     assert a.symbol_agreement == 1.0 and a.unmatched == 0 and a.median_start_error == 0.0
+
+
+def test_quick_measured_movement_that_holds_is_kept():
+    """Half a beat at 96 bpm straight after another movement: the fitted
+    logistic makes it 0.17 s, under the glitch limit, and it was dropped
+    although the arm then holds its new pose for two beats (a whole-path
+    phrase lost a fifth of its cells).  A glitch swings and comes back."""
+    moves = [
+        (0, 1, "right_shoulder", arm_angles("right", "middle")),
+        (1, F(1, 2), "right_shoulder", arm_angles("forward", "middle")),
+        (4, 1, "right_shoulder", np.zeros(3)),
+    ]
+    expected = Score(symbols=(Symbol(0, 1, "right_arm", "right", "middle"),
+                              Symbol(1, F(1, 2), "right_arm", "forward", "middle"),
+                              Symbol(4, 1, "right_arm", "place", "low")), tempo=96)
+    # A sudden Effort: the fitted reference logistic is quickest on it.
+    joints, _ = build_motion(moves, 96, b=-4.0, x0=0.35)
+    agree = []
+    for seed, sigma in ((0, 0.008), (1, 0.008), (1, 0.015), (2, 0.015)):
+        noisy = joints + np.random.default_rng(seed).normal(0.0, sigma, joints.shape)
+        a = compare_scores(expected, _gestures(segment_motion(noisy, 25.0, tempo=96).score))
+        agree.append(a.symbol_agreement)
+        assert a.unmatched == 0
+    assert np.mean(agree) >= 0.95
+
+
+
+def _pitch_toes(joints: np.ndarray, deg: float) -> np.ndarray:
+    """Joints with both toes pitched `deg` further down about their ankles (toes kept on the floor)."""
+    from scipy.spatial.transform import Rotation
+
+    from capture2notation.body import joint_index
+
+    out = joints.copy()
+    for side in ("right", "left"):
+        a, t = joint_index(f"{side}_ankle"), joint_index(f"{side}_toe")
+        d = out[:, t] - out[:, a]
+        # Pitch down about the horizontal axis across the foot (z × foot: toe down).
+        axis = np.cross([0.0, 0.0, 1.0], d)
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        out[:, t] = out[:, a] + Rotation.from_rotvec(axis * np.radians(deg)).apply(d)
+    # A fitted foot still stands on the floor: raise the body onto its toes.
+    lift = joints[:, joint_index("right_toe"), 2] - out[:, joint_index("right_toe"), 2]
+    return out + lift[:, None, None] * np.array([0.0, 0.0, 1.0])
+
+
+def test_measured_flat_feet_pitched_down_are_not_releve():
+    """A front-view fit pitches flat feet 10-20° further down than the body
+    model's rest pose (13-24° over 32 whole-path clips): measured against the
+    model's pitch every standing frame read as relevé (``support place high``
+    written at beat 0 of Wolofsky's Figure 7).  The relevé threshold is taken
+    from the capture's own flat feet."""
+    # The left leg gestures forward and back: the right foot alone supports, then both.
+    joints, _ = build_motion([(1, 1, "left_hip", np.radians((40.0, 0.0, 0.0))), (3, 1, "left_hip", np.zeros(3))],
+                             60, beats=5)
+    for bias in (12.0, 18.0):
+        noisy = _pitch_toes(joints, bias) + np.random.default_rng(0).normal(0.0, 0.005, joints.shape)
+        seg = segment_motion(noisy, 25.0, tempo=60)
+        levels = seg.labels.support_level[seg.labels.supporting]
+        # Every frame of a supporting foot stands flat: middle level.
+        assert levels.size > 0.6 * seg.labels.supporting.size  # the left foot is lifted 2 beats of 5
+        assert (levels == LEVELS.index("middle")).all()
+        assert not [x for x in seg.score.symbols if x.is_support and x.level == "high"]
+        assert [(x.part, x.direction, x.level) for x in seg.score.symbols if not x.is_support] == [
+            ("left_leg", "forward", "low")]
+
+
+def test_flat_foot_pitch_is_the_lower_decile_of_contacts():
+    from capture2notation.quantise.labels import flat_foot_pitch, support_frames
+
+    high, middle = LEVELS.index("high"), LEVELS.index("middle")
+
+    joints, _ = build_motion([(1, 1, "right_shoulder", arm_angles("right", "middle"))], 60, beats=4)
+    biased = _pitch_toes(joints, 15.0)
+    contact, _ = support_frames(biased, 25.0)
+    flat = flat_foot_pitch(biased, contact)
+    rest = flat_foot_pitch(joints, contact)
+    np.testing.assert_allclose(flat - rest, 15.0, atol=0.5)
+    # Raised 20° from the capture's own flat foot is relevé; the model's rest pitch reads it all as relevé.
+    raised = _pitch_toes(joints, 35.0)
+    assert (support_frames(raised, 25.0, flat_pitch=flat)[1] == high).all()
+    assert (support_frames(biased, 25.0, flat_pitch=flat)[1] == middle).all()
+    assert (support_frames(biased, 25.0)[1] == high).all()

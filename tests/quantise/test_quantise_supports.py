@@ -103,3 +103,96 @@ def test_with_supports_rewrites_the_support_columns():
     assert out.support_level.tolist() == lev.tolist()
     # Gesture columns untouched.
     assert np.array_equal(out.direction[:, : c["support"]], lab.direction[:, : c["support"]])
+
+
+# --- Truth round trip of the support column (virtual dancer → quantiser) ---
+
+from synthetic.interpret import UnreachableWarning, interpret  # noqa: E402
+from synthetic.phrases import phrase  # noqa: E402
+from synthetic.random_scores import random_score  # noqa: E402
+
+from capture2notation.notation import Score, Symbol  # noqa: E402
+
+#: Support phrases (start, duration, part, direction, level), each with the
+#: case it guards.
+SUPPORT_CASES = {
+    # (a) both feet, then a transfer onto one foot: starts at 1, not 0.
+    "transfer": ["0 1 support place middle", "1 4 right_support place middle"],
+    # (a) in context: a transfer, the free leg gestures at once, a closing.
+    "transfer_gesture_close": ["0 1 support place middle", "1 1 right_support place middle",
+                               "2 1 left_leg forward middle", "3 1 support place middle"],
+    # (b) a step, then a closing: two symbols, not one.
+    "step_close": ["1 1 right_support forward middle", "2 1 support place middle"],
+    # (c) a closing immediately followed by a step of the closing foot.
+    "close_then_step": ["1 1 right_support place middle", "2 1 left_leg forward middle",
+                        "3 1 support place middle", "4 1 left_support left middle", "5 1 support place middle"],
+    # A walk from the first frame, each foot landing and the other stepping at once.
+    "walk": ["0 1 right_support forward middle", "1 1 left_support forward middle",
+             "2 1 right_support forward middle", "3 1 support place middle"],
+    "plie_releve_middle": ["0 2 support place low", "2 2 support place high", "4 2 support place middle"],
+    "releve_on_one_foot": ["0 2 right_support place high", "2 1 left_leg left low", "3 2 support place middle"],
+    "side_steps_then_plie": ["1 1/2 right_support right middle", "3/2 1 support place middle",
+                             "5/2 1 left_support left middle", "7/2 1 support place low"],
+}
+
+
+def _score(lines, tempo):
+    syms = []
+    for line in lines:
+        start, dur, part, direction, level = line.split()
+        syms.append(Symbol(F(start), F(dur), part, direction, level))
+    # An arm gesture two beats after the supports: the dancer's motion then
+    # has exact holds, as every real phrase does (clean-motion quantising).
+    end = max(s.end for s in syms)
+    syms.append(Symbol(end + 2, F(1), "right_arm", "forward", "middle"))
+    return Score(tuple(syms), title="supports", tempo=F(tempo), meter=4)
+
+
+def _truth_supports(score, fps):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UnreachableWarning)
+        joints = interpret(score, fps=fps).joints()
+    unreachable = [str(w.message) for w in caught if issubclass(w.category, UnreachableWarning)]
+    return _supports(segment_motion(joints, fps, tempo=score.tempo).score), unreachable
+
+
+@pytest.mark.parametrize("tempo", [60, 120])
+@pytest.mark.parametrize("name", sorted(SUPPORT_CASES))
+def test_support_phrases_round_trip_exactly_from_truth(name, tempo):
+    score = _score(SUPPORT_CASES[name], tempo)
+    got, unreachable = _truth_supports(score, FPS)
+    assert unreachable == []
+    assert got == _supports(score)
+
+
+@pytest.mark.parametrize("fps", [12.5, 30.0])
+@pytest.mark.parametrize("name", ["step_close", "close_then_step", "plie_releve_middle"])
+def test_support_phrases_round_trip_at_other_frame_rates(name, fps):
+    score = _score(SUPPORT_CASES[name], 90)
+    got, unreachable = _truth_supports(score, fps)
+    assert unreachable == []
+    assert got == _supports(score)
+
+
+def test_leg_phrase_supports_round_trip_exactly():
+    score = phrase("leg_phrase")
+    got, unreachable = _truth_supports(score, FPS)
+    assert unreachable == []
+    assert got == _supports(score)
+    # Spelled out, the cases (a) and (b) of the phrase.
+    assert (F(8), F(1), "right_support") in [(s.start, s.duration, s.part) for s in got]
+    assert [(s.start, s.part, s.direction) for s in got if s.start >= 12] == [
+        (F(12), "right_support", "forward"), (F(13), "support", "place")]
+
+
+def test_random_scores_with_supports_round_trip_their_support_column():
+    rng = np.random.default_rng(20261201)
+    n, exact, count = 6, 0, 0
+    for i in range(n):
+        score = random_score(rng, n_beats=8, random_effort=bool(i % 2))
+        want = _supports(score)
+        count += len(want)
+        got, _ = _truth_supports(score, FPS)
+        exact += got == want
+    assert count >= 6  # the draws do exercise supports
+    assert exact == n
