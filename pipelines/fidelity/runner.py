@@ -59,16 +59,8 @@ ID_COLUMNS = (
 
 
 def resolve_capture(mode: str) -> str:
-    """The capture path to use: ``auto`` picks ``keypoints`` when the fitter and renderer geometry exist."""
-    if mode != "auto":
-        return mode
-    try:
-        import capture2notation.fitting  # noqa: F401
-        import synthetic.render.scene  # noqa: F401
-        from capture2notation.fitting import fit_keypoints  # noqa: F401
-    except ImportError:
-        return "truth"
-    return "keypoints"
+    """The capture path to use: ``auto`` is the keypoint path (projected landmarks, then 3D fitting)."""
+    return "keypoints" if mode == "auto" else mode
 
 
 def run_condition(job: Job, seed: int, capture_mode="truth", fps: float = 25.0, bootstrap: int = 30, scores=None) -> dict:

@@ -1,4 +1,4 @@
-"""Frame writers: an mp4 file (OpenCV ``mp4v``) or a folder of PNG images.
+"""Frame writers: an mp4 file (H.264 through ``capture2notation.io.video``) or a folder of PNG images.
 
 Both are atomic: frames go to a temporary file / folder beside the target,
 renamed into place only when the writer closes without an error, so a failed
@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 
 from capture2notation.errors import SyntheticError, VideoError
-from capture2notation.io.atomic import atomic_path
+from capture2notation.io.video import VideoWriter
 
 __all__ = ["FrameWriter", "Mp4Writer", "PngFolderWriter", "open_writer"]
 
@@ -55,34 +55,26 @@ class FrameWriter:
 
 
 class Mp4Writer(FrameWriter):
-    """mp4 video through ``cv2.VideoWriter`` with the ``mp4v`` codec."""
+    """mp4 video through :class:`capture2notation.io.video.VideoWriter`.
+
+    That is H.264 (browser-playable, and what rehearsal footage usually is)
+    for even frame sizes and OpenCV's ``mp4v`` otherwise; the file appears
+    atomically when the writer closes without an error.
+    """
 
     def _open(self):
-        self._ctx = atomic_path(self.path, suffix=".mp4")
-        tmp = self._ctx.__enter__()
-        self._vw = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), self.fps, self.size)
-        if not self._vw.isOpened():
-            self._ctx.__exit__(VideoError, None, None)
-            raise VideoError(f"{self.path}: OpenCV cannot open an mp4v video writer at {self.size} and {self.fps} fps")
+        self._vw = VideoWriter(self.path, self.fps, self.size).__enter__()
 
     def _write(self, frame):
         self._vw.write(frame)
 
     def _close(self, ok: bool):
-        self._vw.release()
-        if ok and self.count == 0:
-            ok = False
-            err = VideoError(f"{self.path}: no frames were written")
-        else:
-            err = None
-        if ok:
-            self._ctx.__exit__(None, None, None)
-        else:
-            # Leaving the context with an exception removes the temporary file.
-            try:
-                self._ctx.__exit__(RuntimeError, RuntimeError("render failed"), None)
-            except RuntimeError:
-                pass
+        err = VideoError(f"{self.path}: no frames were written") if ok and self.count == 0 else None
+        if ok and err is None:
+            self._vw.__exit__(None, None, None)
+            return
+        # Leaving with an exception removes the temporary file (and returns False).
+        self._vw.__exit__(VideoError, err or VideoError(f"{self.path}: render failed"), None)
         if err is not None:
             raise err
 
