@@ -30,6 +30,7 @@ import numpy as np
 from ..body import JOINTS, Body, joint_index
 from ..errors import FittingError
 from .camera import DEFAULT_HFOV_DEG, Camera
+from .depth import choose_arm_depths
 from .ik import initial_angles
 from .lengths import offsets_from_ratios
 from .model import PoseModel
@@ -319,6 +320,7 @@ def _check_2d(xy, confidence, world):
     xy = np.asarray(xy, float)
     if xy.ndim != 3 or xy.shape[1] != 33 or xy.shape[2] < 2:
         raise FittingError(f"keypoints must have shape (T, 33, 2), got {xy.shape}")
+    image_z = xy[..., 2] if xy.shape[2] > 2 else None
     xy = xy[..., :2]
     conf = np.asarray(confidence, float)
     if conf.shape != xy.shape[:2]:
@@ -330,7 +332,7 @@ def _check_2d(xy, confidence, world):
             raise FittingError(f"world landmarks must have shape {xy.shape[:2] + (3,)}, got {world.shape}")
     if xy.shape[0] == 0:
         raise FittingError("no frames to fit (T = 0)")
-    return xy, conf, world
+    return xy, conf, world, image_z
 
 
 def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, world=None,
@@ -367,7 +369,7 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
     FitResult
     """
     opt = options or FitOptions()
-    xy, conf, world = _check_2d(xy, confidence, world)
+    xy, conf, world, image_z = _check_2d(xy, confidence, world)
     check_fps(fps)
     body = body or Body()
     set_floor = camera is None
@@ -379,6 +381,12 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
     if not set_floor and opt.sigma_floor > 0:
         _floor_terms(model, terms, tc, names)
     params0 = _initial_params(model, camera, names, tx, tc, tw)
+    if tw is not None and opt.depth is not None:
+        # Decide which side of the image plane each arm segment lies on before
+        # the continuous solve, which only refines the side it starts on.
+        tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth)
+        _, terms.dirs, terms.wd = _direction_terms(names, tc, tw)
+        params0 = _initial_params(model, camera, names, tx, tc, tw)
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
     params, cost = rewarm(model, params, cost, terms, fps, opt)
     for _ in range(opt.root_passes):
@@ -547,6 +555,6 @@ def fit_track(track, camera: Camera | None = None, body: Body | None = None,
         world = np.asarray(world, float)
         if not np.any(np.isfinite(world)):
             world = None
-    return fit_keypoints(xy[..., :2], vis, float(track.fps), camera=camera, world=world, body=body,
+    return fit_keypoints(xy, vis, float(track.fps), camera=camera, world=world, body=body,
                          times=getattr(track, "times", None), image_size=tuple(np.asarray(track.image_size).tolist()),
                          options=options)

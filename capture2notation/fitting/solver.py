@@ -26,6 +26,7 @@ import numpy as np
 from ..body import JOINTS
 from ..errors import FittingError
 from .camera import Camera
+from .depth import DepthOptions
 from .model import PoseModel
 from .result import FitResult
 
@@ -97,6 +98,11 @@ class FitOptions:
         Frames with fewer usable targets are returned as NaN.
     min_confidence : float
         Landmarks below this confidence are ignored.
+    depth : DepthOptions or None
+        Weights of the choice of each arm's side of the image plane
+        (:mod:`~capture2notation.fitting.depth`) made before the solve when
+        world landmarks are given; None leaves the side to the world
+        landmarks and the starting pose.
 
     Notes
     -----
@@ -131,6 +137,7 @@ class FitOptions:
     polish_iterations: int = 3
     min_targets: int = 6
     min_confidence: float = 0.1
+    depth: DepthOptions | None = DepthOptions()
 
 
 @dataclass
