@@ -146,3 +146,26 @@ def test_unreachable_scheduler_is_a_one_line_error(tmp_path):
     cfg = StudyConfig(**TINY)
     with pytest.raises(PipelineError, match="Dask scheduler"):
         run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False, connect_timeout=2)
+
+
+def _line(factor, condition, accuracy, percent, trials=72):
+    return {"factor": factor, "condition": condition, "jobs": 6, "failed": 0, "symbol_accuracy": accuracy,
+            "angle_error_deg": 5.0, "timing_error_s": 0.05, "percent_correct": percent, "trials": trials}
+
+
+def test_conclusions_judge_the_observer_against_the_experts_with_a_binomial_test():
+    from pipelines.fidelity.report import conclusions
+
+    base = "25 Hz keyframe, 640x480, front, q=none, noise=0"
+    table = [
+        _line("baseline", base, 0.90, 80.0),
+        # 55 of 72 (76.4 %) is below 78.70 % but well within chance: sufficient.
+        _line("view", "25 Hz keyframe, 640x480, 45, q=none, noise=0", 0.88, 100 * 55 / 72),
+        # 45 of 72 (62.5 %): p ≈ 0.001 below the experts: not sufficient.
+        _line("view", "25 Hz keyframe, 640x480, side, q=none, noise=0", 0.90, 100 * 45 / 72),
+        # Symbols 10 points below the baseline: not sufficient whatever the observer.
+        _line("noise", "25 Hz keyframe, 640x480, front, q=none, noise=5", 0.80, 90.0),
+    ]
+    text = " ".join(conclusions(table, {}))
+    assert "Viewpoint: sufficient — front, 45. Not sufficient — side (symbols 90%, observer 62 %)" in text
+    assert "Pixel noise: sufficient — noise=0. Not sufficient — noise=5" in text
