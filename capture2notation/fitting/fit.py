@@ -103,6 +103,15 @@ _DIRECTIONS: tuple[tuple[str, str, float], ...] = (
     ("left_ear", "right_ear", 0.3),
 )
 
+#: Limbs whose middle joint may be hidden (a leg raised straight at the camera
+#: hides its knee behind the foot): where the middle target has no world
+#: position, the direction root → end (weight) stands in for the two segments'
+#: directions, so the limb keeps the evidence of which side it points to.
+_SKIP_DIRECTIONS: tuple[tuple[str, str, str, float], ...] = tuple(
+    (f"{s}_{a}", f"{s}_{m}", f"{s}_{b}", 1.0) for s in ("right", "left")
+    for a, m, b in (("hip", "knee", "ankle"), ("shoulder", "elbow", "wrist"))
+)
+
 #: Joints measured by other joints' targets (for the output confidence).
 _DERIVED_CONF = {
     "waist": ("pelvis", "neck"),
@@ -134,12 +143,45 @@ def _targets_from_landmarks(xy, conf, world, opt):
         if world is not None:
             okw = ok & np.all(np.isfinite(world[:, lms]), axis=(1, 2))
             tw[okw, i] = world[okw][:, lms].mean(axis=1)
+    if tw is not None:
+        _impute_hips(names, tw)
     return names, tx, tc, tw
+
+
+#: Weight of a world target placed by :func:`_impute_hips` rather than measured.
+_IMPUTED_WEIGHT = 0.7
+
+
+def _impute_hips(names, tw) -> None:
+    """Place unseen pelvis and hip world targets from the hip-centred origin, in place.
+
+    World landmarks are hip-centred: the midpoint of the hips is the origin
+    in every frame whether or not the hips are seen.  So the pelvis target is
+    the origin, and a hip the image does not show (a thigh raised towards the
+    camera hides it) is the mirror of the other.  Without them the thigh,
+    whose knee alone is seen, would lose its world direction, the only
+    evidence of which side of the image plane it points to.
+    """
+    framed = np.any(np.isfinite(tw), axis=(1, 2))
+    ip, il, ir = names.index("pelvis"), names.index("left_hip"), names.index("right_hip")
+    have = np.all(np.isfinite(tw), axis=2)
+    for a, b in ((il, ir), (ir, il)):
+        miss = ~have[:, a] & have[:, b]
+        tw[miss, a] = -tw[miss, b]
+    miss = ~have[:, ip] & framed
+    tw[miss, ip] = 0.0
+
+
+def _world_weights(tc, tw) -> np.ndarray:
+    """(T, N) confidence of the world targets: the landmarks', or :data:`_IMPUTED_WEIGHT` where imputed."""
+    have = np.all(np.isfinite(tw), axis=2)
+    return np.where(have, np.where(tc > 0, tc, _IMPUTED_WEIGHT), 0.0)
 
 
 def _direction_terms(names, tc, tw):
     """Unit directions of segments from target world positions; (B,2) name pairs, (T,B,3), (T,B)."""
     pairs, dirs, w = [], [], []
+    cw = _world_weights(tc, tw)
     for a, b, wt in _DIRECTIONS:
         ia, ib = names.index(a), names.index(b)
         d = tw[:, ib] - tw[:, ia]
@@ -148,7 +190,15 @@ def _direction_terms(names, tc, tw):
         u = np.where(ok[:, None], d / np.where(ok[:, None], ln, 1.0), np.nan)
         pairs.append((a, b))
         dirs.append(u)
-        w.append(np.where(ok, wt * np.minimum(tc[:, ia], tc[:, ib]), 0.0))
+        w.append(np.where(ok, wt * np.minimum(cw[:, ia], cw[:, ib]), 0.0))
+    for a, mid, b, wt in _SKIP_DIRECTIONS:
+        ia, im, ib = names.index(a), names.index(mid), names.index(b)
+        d = tw[:, ib] - tw[:, ia]
+        ln = np.linalg.norm(d, axis=-1, keepdims=True)
+        ok = np.isfinite(ln[:, 0]) & (ln[:, 0] > 1e-6) & (cw[:, im] <= 0)
+        pairs.append((a, b))
+        dirs.append(np.where(ok[:, None], d / np.where(ok[:, None], ln, 1.0), np.nan))
+        w.append(np.where(ok, wt * np.minimum(cw[:, ia], cw[:, ib]), 0.0))
     return pairs, np.stack(dirs, 1), np.stack(w, 1)
 
 
@@ -244,9 +294,18 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool
     if tw is not None:
         # World landmarks give 3D directions: start from their closed-form pose.
         pts = np.full((T, _J, 3), np.nan)
+        cw = _world_weights(tc, tw)
         for i, name in enumerate(names):
             if name in JOINTS:
-                pts[:, joint_index(name)] = np.where((tc[:, i] > 0)[:, None], tw[:, i] @ cam.R, np.nan)
+                pts[:, joint_index(name)] = np.where((cw[:, i] > 0)[:, None], tw[:, i] @ cam.R, np.nan)
+        # A hidden knee or elbow (the limb points at the camera) starts on the
+        # straight line from its root to its end, so the limb starts on the
+        # side the world landmarks give rather than hanging.
+        for a, mid, b, _ in _SKIP_DIRECTIONS:
+            ia, im, ib = joint_index(a), joint_index(mid), joint_index(b)
+            la, lb = (np.linalg.norm(model.offsets[model.index(n)]) for n in (mid, b))
+            miss = ~np.all(np.isfinite(pts[:, im]), axis=1)
+            pts[miss, im] = pts[miss, ia] + la / (la + lb) * (pts[miss, ib] - pts[miss, ia])
     else:
         pts = _lift(model, cam, names, tx, tc, root, yaw)
     ang = initial_angles(pts, model)

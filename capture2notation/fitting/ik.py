@@ -154,11 +154,27 @@ def _limb(ang, P, G_parent, root, mid, end, sign, lim):
     sin_b = np.linalg.norm(perp, axis=1)
     bent = np.isfinite(sin_b) & (sin_b > 0.2)
     y_bend = sign * perp / np.maximum(sin_b, 1e-12)[:, None]
-    y_ax = np.where(bent[:, None], y_bend, y_rest)
     z_ax = -u_l
-    x_ax = np.cross(y_ax, z_ax)
-    R = np.stack([x_ax, y_ax, z_ax], axis=-1)
-    ang[:, r] = np.where(ok_u[:, None], _euler_in_limits(R, lim[r]), 0.0)
+    # The bend's plane fixes the root joint's twist; where that twist is
+    # beyond the limits (a noisy, slight bend of a raised leg), clipping each
+    # Euler angle on its own can swing the segment far from `u` (a thigh
+    # raised forward ended up back).  So the untwisted frames are candidates
+    # too — the shortest swing, and the two (rx, ry) pairs with rz = 0, which
+    # reach a leg raised high forward and a little aside — and the bend's
+    # frame is kept unless another points the segment clearly closer to `u`
+    # after clipping.
+    euler = [_euler_in_limits(np.stack([np.cross(y_ax, z_ax), y_ax, z_ax], axis=-1), lim[r])
+             for y_ax in (np.where(bent[:, None], y_bend, y_rest), y_rest)]
+    rx = np.arcsin(np.clip(u_l[:, 1], -1.0, 1.0))
+    for rx_k in (rx, np.pi - rx):
+        c = np.cos(rx_k)
+        ry_k = np.arctan2(-u_l[:, 0] * np.sign(c), -u_l[:, 2] * np.sign(c))
+        e = np.stack([np.angle(np.exp(1j * rx_k)), ry_k, np.zeros_like(rx_k)], axis=-1)
+        euler.append(np.clip(e, lim[r, :, 0], lim[r, :, 1]))
+    euler = np.stack(euler)  # (4, T, 3)
+    cos = np.sum(-euler_to_matrix(euler)[..., :, 2] * u_l, axis=-1)  # (4, T)
+    pick = np.where(cos[0] >= cos.max(axis=0) - 0.02, 0, np.argmax(cos, axis=0))
+    ang[:, r] = np.where(ok_u[:, None], euler[pick, np.arange(len(pick))], 0.0)
     beta = np.arccos(np.clip(np.sum(u_l * f_l, axis=1), -1, 1))
     flex = np.where(np.isfinite(beta) & ok_u, sign * beta, 0.0)
     ang[:, m, 0] = np.clip(flex, lim[m, 0, 0], lim[m, 0, 1])
