@@ -86,9 +86,33 @@ def _leg_targets() -> tuple:
 #: Targets of the right arm (the left arm mirrors them).
 ARM_TARGETS: tuple = _arm_targets()
 LEG_TARGETS: tuple = _leg_targets()
-#: Head and chest: upright, tilted 45° any way, bowed forward.
+#: Head: upright, tilted 45° any way, bowed forward.
 HEAD_TARGETS: tuple = (("place", "high", 0),) + tuple((d, "high", 0) for d in _SECTORS) + (("forward", "middle", 0),)
-CHEST_TARGETS: tuple = HEAD_TARGETS
+
+
+def _chest_targets() -> tuple:
+    """The head's targets that the waist and chest reach exactly.
+
+    ``chest back high`` (the spine arches to about 40° within the waist's
+    and chest's extensions) and ``chest forward middle`` (about 76° of
+    flexion) are approached only (:func:`synthetic.trunk.chest_reach`): the
+    chest arrives a few degrees off its written direction, still in the
+    symbol's sector (so :mod:`synthetic.reach` raises nothing), but a
+    quantiser parting back-to-back movements at exactly written poses can
+    no longer see the arrival.
+    """
+    from capture2notation.body import Body
+    from capture2notation.notation.directions import canonical_vector
+
+    from .trunk import chest_reach
+
+    reach = chest_reach(Body())
+    return tuple(t for t in HEAD_TARGETS
+                 if np.allclose(reach(canonical_vector(t[0], t[1])[None])[0], canonical_vector(t[0], t[1]), atol=1e-9))
+
+
+#: Chest: the head's targets within the trunk's extremes.
+CHEST_TARGETS: tuple = _chest_targets()
 _DURATIONS = tuple(Fraction(n, 4) for n in (2, 3, 4, 6, 8))
 #: Frame rate at which a draw is verified (support speeds need a real rate).
 VERIFY_FPS = 25.0

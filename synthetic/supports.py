@@ -53,6 +53,19 @@ STEP_LIFT = 0.03
 #: frame), not while it is still settling: the step arrives at the end of its
 #: symbol, like a gesture.
 FOOT_CONTACT_SPEED = 0.5
+#: Height (m) of the lowest point of a gesturing foot above the floor that
+#: the foot reaches, rising at :data:`LIFT_OFF_SPEED`, when its gesture
+#: leaves the floor: above DESIGN.md's 3 cm support height, so the foot
+#: stops reading as supporting on the frame after the gesture's start (the
+#: Effort logistic alone starts so slowly that a foot would go on reading
+#: as supporting for a fifth of the gesture).
+LIFT_OFF_CLEARANCE = 0.04
+#: Vertical speed (m/s) of that lift-off: above the 0.2 m/s support speed,
+#: yet gentle (the knee bends about 20° a frame at 25 fps, not 30°).
+LIFT_OFF_SPEED = 0.25
+
+#: DESIGN.md: a foot slower than this (m/s) on the floor supports.
+_SUPPORT_SPEED = 0.2
 
 SUPPORT_FEET = {"support": ("right", "left"), "right_support": ("right",), "left_support": ("left",)}
 
@@ -146,13 +159,20 @@ class Support:
         self.pitch = {f: np.zeros(T) for f in ("right", "left")}
         self.floor = {f: np.ones(T, bool) for f in ("right", "left")}
         self.landing = {f: np.zeros(T, bool) for f in ("right", "left")}
+        # Frames on which a foot that a support released holds its leg.
+        self.released = {f: np.zeros(T, bool) for f in ("right", "left")}
         self._plan(score)
 
     def _just_landed(self, foot: str, f0: int) -> bool:
-        """Whether `foot` comes down onto the floor at frame `f0` (or `f0` is the first frame)."""
+        """Whether `foot` comes down onto the floor at frame `f0` (or `f0` is the first frame).
+
+        A heel lowered from relevé slower than DESIGN.md's 0.2 m/s already
+        rests on `f0` (its incoming step is slow): it needs no frame of rest.
+        """
         if f0 == 0:
             return True
-        return bool(self.landing[foot][f0]) or self.ankle[foot][f0 - 1, 2] > self.ankle[foot][f0, 2] + 1e-9
+        drop = self.ankle[foot][f0 - 1, 2] - self.ankle[foot][f0, 2]
+        return bool(self.landing[foot][f0]) or (drop > 1e-9 and drop * self.fps >= _SUPPORT_SPEED)
 
     def _leg_length(self, level):
         limb = self.limbs["right"]
@@ -198,12 +218,15 @@ class Support:
                 pa, pb = self.pitch[foot][f0], self.level_pitch[s.level]
                 a = self.ankle[foot]
                 sf_foot, lift_foot = sf, lift
-                if s.direction != "place" and planted and self._just_landed(foot, f0) and f1 - f0 > 1:
+                if s.direction != "place" and planted and self._just_landed(foot, f0) and f1 - f0 > 3:
                     # A foot that arrives on the floor at f0 (or stands on the
                     # first frame, whose incoming speed is unknown) rests one
                     # frame before it steps: a foot lifted again on its
                     # landing frame is never still on the floor, so the
-                    # support it landed for would never be seen.
+                    # support it landed for would never be seen.  Only
+                    # with more than three frames to step: a shorter step
+                    # that rested would still be on the floor two frames
+                    # before it lands (it must arrive within one).
                     tau1 = (n - f0 - 1) / (f1 - f0 - 1)
                     sf_foot = np.where(tau1 > 0, progress(np.maximum(tau1, 1e-9), self.eff.time, self.eff.weight), 0.0)
                     lift_foot = foot_lift(tau1, (f1 - f0 - 1) / self.fps, STEP_LIFT * body.height)
@@ -247,6 +270,7 @@ class Support:
                 self.root[m] = ra + sr[:, None] * (key - ra)
             self.root[f1:] = key
             last_key = max(last_key, f1)
+        self._release(sups)
         # Gesturing frames: from a gesture's start to the next support's start.
         for foot in ("right", "left"):
             sup, ges = self.events[foot]
@@ -254,6 +278,29 @@ class Support:
                 nxt = min((x.start for x in sup if x.start >= g.end), default=None)
                 stop = T if nxt is None else frame(nxt) + 1
                 self.floor[foot][frame(g.start) + 1 : stop] = False
+
+    def _release(self, sups):
+        """Mark the frames on which a foot released by a support holds its leg.
+
+        A support that takes the weight off a foot without naming it (a step
+        onto the other foot) leaves that foot free, and an unnotated part
+        holds (DESIGN.md): from the support's end frame the leg keeps its
+        pose in the body frame until its next symbol starts, instead of
+        reaching for the spot it left while the pelvis moves on (a drift
+        that reads as an unwritten gesture).
+        """
+        for s in sups:
+            before = _weight_feet(sups, self.events, s.start)
+            after = _weight_feet(sups, self.events, s.end)
+            f1 = self.frame(s.end)
+            for foot in ("right", "left"):
+                if foot in SUPPORT_FEET[s.part] or foot not in before or foot in after:
+                    continue
+                sup, ges = self.events[foot]
+                nxt = min([x.start for x in sup + ges if x.start >= s.end], default=None)
+                stop = self.T - 1 if nxt is None else self.frame(nxt)
+                self.released[foot][f1 + 1 : stop + 1] = True
+                self.floor[foot][f1 + 1 : stop + 1] = False
 
     def ik(self, foot: str, ankle_pos=None, foot_R=None, frames=slice(None)):
         """Leg pose putting the ankle at `ankle_pos` with the foot turned to `foot_R`.
@@ -310,6 +357,11 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
         floor, landing = sup.floor[foot], sup.landing[foot]
         Qg, bg = Q.copy(), beta.copy()
         ankle_g = ankle.copy()
+        held = sup.released[foot]
+        for run in np.split(np.flatnonzero(held), np.flatnonzero(np.diff(held) < 0) + 1) if held.any() else []:
+            if run.size:
+                # A released leg holds the pose it had when the support ended.
+                Qg[run], bg[run], ankle_g[run] = Q[run[0] - 1], beta[run[0] - 1], ankle[run[0] - 1]
         for f0, f1, syms in group_moves(limb, symbols, frame, T):
             stop = f1 + 1 + int(np.argmax(floor[f1 + 1 :])) if np.any(floor[f1 + 1 :]) else T
             a0 = ankle_g[f0].copy()
@@ -347,24 +399,49 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
         # The free foot stays above the floor (z = 0): the ankle no lower than
         # the sole's thickness (its standing height less the toe's), and the
         # toe above the floor too (a pitched foot reaches lower than its
-        # ankle), by bending the knee.
-        floor_z = np.full(T, sup.ankle0 - sup.toe0)
+        # ankle), by bending the knee.  A foot leaving the floor for a
+        # gesture lifts off at once (:data:`LIFT_OFF_CLEARANCE`), so the
+        # gesture visibly begins at its start.
+        clear = _lift_off(floor, sup.toe0, sup.fps)
+        floor_z = sup.ankle0 - sup.toe0 + clear
         Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
         ja = limb.joints[2]
         lim = sup.body.limits[ja]
         for _ in range(20):
-            deficit = -_toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
+            deficit = clear - _toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
             low = free & (deficit > 1e-6)
             if not np.any(low):
                 break
             # Near the floor the free foot flexes towards flat, and the knee
-            # bends (which also tips the foot down: overshoot a little).
+            # bends (which also tips the foot down: overshoot a little, but
+            # not while lifting off, where a doubled lift would jerk the
+            # thigh forward in one frame).
             shin = Qf[low] @ rot_x(limb.middle_angle(bf[low]))
             flat = np.clip(euler_near(shin.transpose(0, 2, 1), 0.0, lim), lim[:, 0], lim[:, 1])
             ankle[low, 0] = np.maximum(ankle[low, 0], flat[:, 0])
-            floor_z[low] += 2.0 * deficit[low] + 1e-4
+            floor_z[low] += np.where(clear[low] > 0, 1.0, 2.0) * deficit[low] + 1e-4
             Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
         out[f"{foot}_leg"] = (Qf, bf, ankle)
+    return out
+
+
+def _lift_off(floor, toe0: float, fps: float) -> np.ndarray:
+    """(T,) least height of a free foot's toe above the floor, metres.
+
+    From each frame where a foot driven by the floor starts gesturing, the
+    clearance rises from the toe's standing height `toe0` at
+    :data:`LIFT_OFF_SPEED` to :data:`LIFT_OFF_CLEARANCE` and stays
+    there while the leg gestures (a gesture that naturally carries the foot
+    higher is not affected); elsewhere it is zero (the floor).
+    """
+    T = len(floor)
+    out = np.zeros(T)
+    starts = np.flatnonzero(floor[:-1] & ~floor[1:])
+    ends = np.r_[np.flatnonzero(~floor[:-1] & floor[1:]) + 1, T]
+    for f0 in starts:
+        f1 = int(ends[np.searchsorted(ends, f0 + 1)])
+        k = np.arange(f0 + 1, f1)
+        out[k] = np.minimum(toe0 + LIFT_OFF_SPEED * (k - f0) / fps, LIFT_OFF_CLEARANCE)
     return out
 
 

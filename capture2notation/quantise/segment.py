@@ -48,6 +48,10 @@ Supports
     See :mod:`.supports`: the weight-bearing feet and their level; a
     weight-bearing foot that travelled is a step.  Legs write gestures only
     while their foot is off the floor (a leg that lands is part of a support).
+    Clean motion also parts a leg's motion where the weight arrives (the
+    pelvis comes to rest or to a speed minimum on a grid frame), and a leg
+    that arrives there on no written pose was carried by the weight
+    transfer (a foot a step left behind): no gesture is written for it.
 """
 
 from __future__ import annotations
@@ -405,14 +409,16 @@ def _off_canonical_series(v: np.ndarray) -> np.ndarray:
 
 
 def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = None, tol: float = 0.05,
-                 min_change: float = 5.0):
+                 min_change: float = 5.0, arrivals: np.ndarray | None = None):
     """``(f, since) -> bool``: frame f can end a movement.
 
     The part must be exactly where some symbol would put it, f must be a
     grid frame (when `on_grid` is given: the frame a renderer gives a grid
     time), and the pose must be at least `min_change` degrees from its pose
     at frame `since` (a movement arrives somewhere new).  A limb sweeping
-    through a written direction mid-movement rarely does all of these."""
+    through a written direction mid-movement rarely does all of these.
+    Frames flagged in `arrivals` (T,) — a leg's: where the weight arrives —
+    end a movement on a grid frame whatever the pose."""
     cols = [labels.index(part)] + [labels.index(p) for p in _LIMBS.get(part, ())]
     if part in _LIMBS:
         whole = _off_canonical_series(labels.vectors[:, cols[0]])
@@ -426,7 +432,11 @@ def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = No
     if on_grid is not None:
         ok = ok & on_grid
 
+    forced = np.zeros_like(ok) if arrivals is None else arrivals & (True if on_grid is None else on_grid)
+
     def key(f: int, since: int) -> bool:
+        if forced[f]:
+            return True
         if not ok[f]:
             return False
         change = max(float(_angle_deg(labels.vectors[f, c], labels.vectors[since, c])) for c in cols)
@@ -436,6 +446,25 @@ def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = No
 
     key.on_grid = on_grid is not None
     return key
+
+
+def _weight_arrivals(joints: np.ndarray) -> np.ndarray:
+    """(T,) bool: frames where the weight arrives (clean motion).
+
+    The pelvis moves with the supports only, each support movement in one
+    smooth push: it comes to rest, or — a support following back to back,
+    which starts from rest — slows to a minimum of its speed, where a
+    support movement arrives.  That may be the very frame a leg gesture
+    starts.
+    """
+    step = np.linalg.norm(np.diff(joints[:, joint_index("pelvis")], axis=0), axis=-1)
+    out = np.zeros(len(joints), bool)
+    if step.size == 0:
+        return out
+    nxt = np.r_[step[1:], 0.0]
+    after = np.r_[step[2:], np.inf, np.inf]
+    out[1:] = (step > 1e-9) & (nxt < step) & (nxt <= after)
+    return out
 
 
 def _noise_speed(noise: float, fps: float, window: int) -> float:
@@ -518,8 +547,15 @@ def _has_exact_holds(labels: FrameLabels, joints: np.ndarray, min_intervals: int
     """
     steps = [_angle_deg(u[:-1], u[1:]) for u in (labels.vectors[:, labels.index(p)] for p in tuple(_LIMBS) + _SINGLE)]
     # The pelvis too (metres → millimetres): a plié moves little else.
-    steps.append(1e3 * np.linalg.norm(np.diff(joints[:, joint_index("pelvis")], axis=0), axis=-1))
-    return any(np.sum(st < 1e-9) >= min_intervals and np.nanmax(st, initial=0.0) > 0.01 for st in steps)
+    pelvis = 1e3 * np.linalg.norm(np.diff(joints[:, joint_index("pelvis")], axis=0), axis=-1)
+    steps.append(pelvis)
+    if any(np.sum(st < 1e-9) >= min_intervals and np.nanmax(st, initial=0.0) > 0.01 for st in steps):
+        return True
+    # Supports back to back to the end move the pelvis and legs all the
+    # time; then an unnotated part that holds to the last bit while the
+    # weight moves (no fit keeps a limb exactly still) shows the motion clean.
+    return bool(np.nanmax(pelvis, initial=0.0) > 0.01 and len(pelvis) >= min_intervals and any(
+        bool(np.all(st < 1e-9)) for st in steps[:-1]))
 
 
 def _gesture_movements(
@@ -558,7 +594,8 @@ def _gesture_movements(
             # the knee): it gestures only between leaving and reaching the floor.
             down = labels.supporting[:, _FOOT[part]]
             speed = np.where(down[:-1] & down[1:], 0.0, speed)
-        key = _key_pose_fn(labels, part, on_grid) if clean else None
+        arrivals = _weight_arrivals(joints) if clean and part in _FOOT else None
+        key = _key_pose_fn(labels, part, on_grid, arrivals=arrivals) if clean else None
         spans = movement_spans(speed, low, high, params.split_ratio, key_pose=key)
         state = _DEFAULT.get(part, ("place", "low")) + (0,)
         for i, (a, b) in enumerate(spans):
@@ -585,6 +622,11 @@ def _gesture_movements(
                     continue
                 end_f = min(max(int(round(t1 * fps)), start_f + 1), T - 1)
                 frames = slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))
+            if arrivals is not None and arrivals[end_f] and not _key_pose_fn(labels, part)(end_f, start_f):
+                # Clean motion: a free leg that arrives with the weight and on
+                # no written pose was carried by the weight transfer (a foot
+                # a step left behind), not a gesture.
+                continue
             if part in _FOOT and labels.supporting[end_f, _FOOT[part]]:
                 # A leg that arrives on the floor is a support, not a gesture.
                 state = ("place", "low", 0)

@@ -406,7 +406,10 @@ def _step_direction(joints, labels: FrameLabels, a: int, k: int, part: int, heig
         side = ("right", "left")[f]
         foot = joints[k, joint_index(f"{side}_ankle")]
         moved = np.linalg.norm((foot - joints[a, joint_index(f"{side}_ankle")])[:2])
-        if moved < 0.05:
+        if moved < 0.05 and labels.supporting[a, f]:
+            # A foot that bore weight where it stands did not step.  One
+            # that was off the floor (left behind by the other foot's step)
+            # may land a step away from the weight where it lifted.
             continue
         rel = foot - joints[a, joint_index(f"{side}_hip")]
         rel[2] = 0.0

@@ -7,6 +7,7 @@ import pytest
 
 from capture2notation.body import Body, joint_index
 from capture2notation.notation import Score, Symbol
+from capture2notation.notation.model import Effort
 from synthetic.interpret import interpret
 
 BODY = Body()
@@ -48,3 +49,56 @@ def test_a_step_from_rest_leaves_the_foot_on_the_first_frame():
     a = J[:, joint_index("right_ankle")]
     assert np.linalg.norm(a[1] - a[0]) < 1e-9
     assert a[2, 2] - a[0, 2] > 0.005
+
+
+def _sym(start, dur, part, direction, level, bend=0):
+    return Symbol(F(start), F(dur), part, direction, level, bend)
+
+
+@pytest.mark.parametrize("fps", [12.5, 25.0])
+def test_a_gesturing_foot_leaves_the_floor_on_its_start(fps):
+    """A leg gesture begins at its start (DESIGN.md): with a slow-starting
+    Effort the logistic alone keeps the foot within 3 cm and slower than
+    0.2 m/s for a fifth of the gesture; the dancer lifts it off at once."""
+    score = Score((_sym(0, 2, "right_support", "place", "middle"), _sym(2, 2, "left_leg", "forward", "middle", 1),
+                   _sym(4, 3 / 2, "support", "place", "middle")), tempo=F(92), meter=4,
+                  effort=Effort(time=-3.377, weight=0.671, space=0.928))
+    m = interpret(score, fps)
+    sup = _contact(m.joints(), fps, "left")
+    f0 = dict((s.part, f) for s, f, _ in m.events)["left_leg"]
+    assert sup[f0] and not sup[f0 + 1 : f0 + 4].any(), np.flatnonzero(sup)
+
+
+def test_a_foot_released_by_a_step_holds_its_leg():
+    """After a step onto the right foot the left foot is free and unnotated:
+    its leg holds its body-frame pose while the right foot rises to relevé
+    (it used to reach for the spot it left, drifting 2° — an unwritten
+    gesture for the quantiser)."""
+    from capture2notation.body import body_frame, segment_vectors
+
+    score = Score((_sym(0, F(1, 2), "right_support", "back", "middle"), _sym(F(1, 2), F(3, 2), "right_support", "place", "high"),
+                   _sym(2, 1, "left_leg", "left_forward", "low", 2), _sym(3, F(3, 2), "support", "place", "middle")),
+                  tempo=F(101), meter=4)
+    m = interpret(score, 25.0)
+    J = m.joints()
+    v = segment_vectors(J, "left_hip", "left_ankle", body_frame(J))
+    ends = {s.part + str(s.start): (f0, f1) for s, f0, f1 in m.events}
+    a, b = ends["right_support0"][1], ends["left_leg2"][0]
+    assert b - a > 10
+    drift = np.degrees(np.arctan2(np.linalg.norm(np.cross(v[a : b + 1], v[a]), axis=-1), v[a : b + 1] @ v[a]))
+    assert drift.max() < 1e-6, drift.max()
+
+
+def test_a_heel_lowered_slowly_steps_at_once_at_low_frame_rates():
+    """A foot whose heel comes down from relevé slower than 0.2 m/s already
+    rests when its step starts: it does not rest a frame more (at 12.5 fps
+    that left it supporting two frames before the step's end)."""
+    score = Score((_sym(0, F(3, 2), "right_support", "back", "middle"), _sym(F(3, 2), F(3, 2), "right_support", "place", "high"),
+                   _sym(3, F(1, 2), "left_leg", "right_forward", "low"), _sym(F(7, 2), F(3, 2), "support", "place", "middle"),
+                   _sym(5, F(1, 2), "right_support", "right", "middle"), _sym(5, 1, "right_arm", "forward", "middle")),
+                  tempo=F(108), meter=4)
+    fps = 12.5
+    m = interpret(score, fps)
+    sup = _contact(m.joints(), fps, "right")
+    (f0, f1), = [(a, b) for x, a, b in m.events if x.part == "right_support" and x.direction == "right"]
+    assert f1 - f0 == 3 and sup[f0] and not sup[f1 - 2] and sup[f1]
