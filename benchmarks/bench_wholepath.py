@@ -1,0 +1,88 @@
+"""The whole path on phrases kept out of development: accuracy and speed.
+
+Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phrases DIR]``.
+
+Each phrase (``benchmarks/holdout/*.lab`` by default: eight phrases of arms,
+legs and supports written for this measurement and never used to tune the
+code) is performed by the virtual dancer, rendered at 25 fps, 640×480, with
+the mannequin, and captured twice:
+
+* from the truth sidecar (no perception: the quantiser alone), and
+* from the video (BlazePose → 3D fit → quantiser), the tempo estimated.
+
+Printed (never asserted): per phrase and overall, the symbol agreement
+(direction + level per part per beat of the original), the median start-time
+error in beats, whether the truth capture is exact, the median limb-direction
+error of the fit, and frames per second of the whole video capture.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HOLDOUT = Path(__file__).resolve().parent / "holdout"
+
+
+def measure(path: Path, workdir: Path, view: str, effort: bool) -> dict:
+    """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
+    from capture2notation.io.truth import read_truth
+    from capture2notation.notation.formats import read
+    from capture2notation.quantise.agreement import compare_scores
+    from pipelines.capture import capture
+    from pipelines.commands.demo import _limb_error
+    from synthetic.render import render_score
+
+    score = read(path)
+    render = render_score(score, workdir / "render", fps=25.0, size=(640, 480), view=view, style="mannequin",
+                          progress=False)
+    from_truth = capture(render / "truth.npz", workdir / "truth", tempo=score.tempo, progress=False, effort=False)
+    exact = compare_scores(score, from_truth.score).exact
+    t0 = time.perf_counter()
+    video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False)
+    seconds = time.perf_counter() - t0
+    a = compare_scores(score, video.score)
+    truth = read_truth(render / "truth.npz")
+    return {
+        "phrase": path.stem,
+        "agreement": a.symbol_agreement,
+        "start_error": a.median_start_error,
+        "truth_exact": exact,
+        "tempo": (float(score.tempo), float(video.score.tempo)),
+        "limb_deg": _limb_error(np.asarray(truth.joints), np.asarray(video.motion.joints)),
+        "fps": truth.n_frames / seconds,
+        "frames": truth.n_frames,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--view", default="front", choices=("front", "45", "side"))
+    ap.add_argument("--phrases", type=Path, default=HOLDOUT, help="folder of .lab phrases")
+    ap.add_argument("--effort", action="store_true", help="include the Effort estimate in the timed capture")
+    args = ap.parse_args()
+    paths = sorted(args.phrases.glob("*.lab"))
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for p in paths:
+            r = measure(p, Path(tmp) / p.stem, args.view, args.effort)
+            rows.append(r)
+            print(f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
+                  f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
+                  f"limb {r['limb_deg']:4.1f}°  {r['fps']:5.1f} fps", flush=True)
+    frames = sum(r["frames"] for r in rows)
+    weights = np.array([r["frames"] for r in rows], float)
+    print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames:")
+    print(f"  symbol agreement (mean over phrases)  {np.mean([r['agreement'] for r in rows]):.1%}")
+    print(f"  median start error                    {np.nanmedian([r['start_error'] for r in rows]):.2f} beat")
+    print(f"  truth captures exact                  {sum(r['truth_exact'] for r in rows)}/{len(rows)}")
+    print(f"  median limb-direction error           {np.median([r['limb_deg'] for r in rows]):.1f}°")
+    print(f"  whole capture speed (frame-weighted)  {np.average([r['fps'] for r in rows], weights=weights):.1f} fps")
+
+
+if __name__ == "__main__":
+    main()
