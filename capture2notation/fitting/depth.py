@@ -229,13 +229,18 @@ def choose_arm_depths(model: PoseModel, cam: Camera, params: np.ndarray, names, 
         m_s, m_e, m_w = (model.index(n) for n in arm[:3])
         upper = float(np.linalg.norm(model.offsets[m_e]))
         fore = float(np.linalg.norm(model.offsets[m_w]))
-        seen = (tc[:, i_s] > 0) & (tc[:, i_e] > 0) & (tc[:, i_w] > 0)
+        # A hidden shoulder (the arm raised at the camera covers it) whose
+        # world target was imputed stands where the starting pose puts it.
+        shown = tc[:, i_s] > 0
+        placed = shown | np.all(np.isfinite(tw[:, i_s]), axis=1)
+        seen = placed & (tc[:, i_e] > 0) & (tc[:, i_w] > 0)
         if not seen.any():
             continue
         # The shoulder on its own pixel's ray, at the starting pose's depth.
         depth = pts[:, m_s, 2]
-        s_px = np.where(seen[:, None], tx[:, i_s], cam.K[:2, 2])
+        s_px = np.where((seen & shown)[:, None], tx[:, i_s], cam.K[:2, 2])
         S = np.concatenate([(s_px - cam.K[:2, 2]) / np.diag(cam.K)[:2], np.ones((T, 1))], axis=1) * depth[:, None]
+        S = np.where((seen & ~shown)[:, None], pts[:, m_s], S)
         e_px = np.where(seen[:, None], tx[:, i_e], s_px)
         w_px = np.where(seen[:, None], tx[:, i_w], s_px)
         E, W = arm_candidates(cam, S, e_px, w_px, upper, fore)  # (T, 4, 3)

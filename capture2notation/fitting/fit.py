@@ -112,6 +112,13 @@ _SKIP_DIRECTIONS: tuple[tuple[str, str, str, float], ...] = tuple(
     for a, m, b in (("hip", "knee", "ankle"), ("shoulder", "elbow", "wrist"))
 )
 
+#: Trunk directions used where the other shoulder is hidden: (from, to, the
+#: other shoulder, weight) — see :func:`_direction_terms`.
+_HALF_TRUNK: tuple[tuple[str, str, str, float], ...] = (
+    ("pelvis", "right_shoulder", "left_shoulder", 0.3),
+    ("pelvis", "left_shoulder", "right_shoulder", 0.3),
+)
+
 #: Joints measured by other joints' targets (for the output confidence).
 _DERIVED_CONF = {
     "waist": ("pelvis", "neck"),
@@ -172,6 +179,35 @@ def _impute_hips(names, tw) -> None:
     tw[miss, ip] = 0.0
 
 
+def _impute_shoulders(model: PoseModel, cam: Camera, params: np.ndarray, names, tc, tw) -> np.ndarray:
+    """World targets for hidden shoulders whose arm is seen, from the starting pose.
+
+    An arm raised straight at the camera hides its shoulder behind the elbow
+    and hand; without a shoulder the upper arm has no world direction and the
+    depth choice of :mod:`~capture2notation.fitting.depth` skips the arm, so
+    the fit settles on whichever side of the image plane the solver reaches
+    first (the mirror image half the time).  The trunk of the starting pose
+    (hips, upright prior) places the shoulder to within a few centimetres,
+    far less than an upper arm, so it stands in: hip-centred, camera-aligned
+    like the world landmarks.
+
+    Returns
+    -------
+    (T, N, 3) ndarray
+        A copy of `tw` with the imputed shoulders.
+    """
+    tw = tw.copy()
+    pts = model.forward(params)
+    pelvis = pts[:, model.index("pelvis")]
+    have = np.all(np.isfinite(tw), axis=2)
+    framed = np.any(have, axis=1)
+    for side in ("right", "left"):
+        i_s, i_e = names.index(f"{side}_shoulder"), names.index(f"{side}_elbow")
+        miss = framed & ~have[:, i_s] & (tc[:, i_e] > 0) & have[:, i_e]
+        tw[miss, i_s] = (pts[miss, model.index(f"{side}_shoulder")] - pelvis[miss]) @ cam.R.T
+    return tw
+
+
 def _world_weights(tc, tw) -> np.ndarray:
     """(T, N) confidence of the world targets: the landmarks', or :data:`_IMPUTED_WEIGHT` where imputed."""
     have = np.all(np.isfinite(tw), axis=2)
@@ -190,6 +226,19 @@ def _direction_terms(names, tc, tw):
         u = np.where(ok[:, None], d / np.where(ok[:, None], ln, 1.0), np.nan)
         pairs.append((a, b))
         dirs.append(u)
+        w.append(np.where(ok, wt * np.minimum(cw[:, ia], cw[:, ib]), 0.0))
+    # One shoulder hidden: no shoulder line and no neck, so nothing else
+    # measures the trunk's turn about the vertical (a side view hides the
+    # hips too); the seen shoulder's direction from the hip-centred origin
+    # does, give or take the trunk's lean.
+    have = np.all(np.isfinite(tw), axis=2)
+    for a, b, other, wt in _HALF_TRUNK:
+        ia, ib, io = names.index(a), names.index(b), names.index(other)
+        d = tw[:, ib] - tw[:, ia]
+        ln = np.linalg.norm(d, axis=-1, keepdims=True)
+        ok = np.isfinite(ln[:, 0]) & (ln[:, 0] > 1e-6) & (tc[:, ib] > 0) & ~(have[:, io] & (tc[:, io] > 0))
+        pairs.append((a, b))
+        dirs.append(np.where(ok[:, None], d / np.where(ok[:, None], ln, 1.0), np.nan))
         w.append(np.where(ok, wt * np.minimum(cw[:, ia], cw[:, ib]), 0.0))
     for a, mid, b, wt in _SKIP_DIRECTIONS:
         ia, im, ib = names.index(a), names.index(mid), names.index(b)
@@ -278,9 +327,7 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool
     yaw = np.arctan2(-to_cam[:, 0], to_cam[:, 1])
     ir, il = names.index("right_hip"), names.index("left_hip")
     if tw is not None:
-        right_w = (tw[:, ir] - tw[:, il]) @ cam.R  # camera axes -> world
-        ok = np.all(np.isfinite(right_w), axis=1) & (np.hypot(right_w[:, 0], right_w[:, 1]) > 1e-6)
-        yaw = np.where(ok, np.arctan2(right_w[:, 1], right_w[:, 0]), yaw)
+        yaw = _world_yaw(names, tc, tw, cam, yaw)
     else:
         seen = tx[:, ir] - tx[:, il]
         right_model = np.stack([np.cos(yaw), np.sin(yaw), np.zeros(T)], 1)
@@ -315,6 +362,36 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool
     ang[:, 0] = np.unwrap(ang[:, 0], axis=0)  # the pelvis turns freely: keep it continuous
     params[:, 3:] = ang[:, model.dof_joint, model.dof_axis]
     return params
+
+
+def _world_yaw(names, tc, tw, cam: Camera, default: np.ndarray) -> np.ndarray:
+    """(T,) starting pelvis yaw from the world targets, radians.
+
+    The hips' line where both hips have world targets; else the shoulders'
+    line (the trunk seldom twists far); else the horizontal direction from
+    the hip-centred origin to the one seen shoulder (off by the trunk's
+    sideways lean only); frames with none of these take the yaw of their
+    neighbours in time, and `default` only when the clip has none at all.
+    A side view often hides both hips (a hanging arm covers the near one),
+    and facing the camera, the old default there, started the pelvis 90° off.
+    """
+    il, ir = names.index("left_hip"), names.index("right_hip")
+    sl, sr = names.index("left_shoulder"), names.index("right_shoulder")
+    shown = (tc > 0) & np.all(np.isfinite(tw), axis=2)
+    cands = ((tw[:, ir] - tw[:, il], np.all(np.isfinite(tw[:, [il, ir]]), axis=(1, 2))),
+             (tw[:, sr] - tw[:, sl], shown[:, sr] & shown[:, sl]),
+             (tw[:, sr], shown[:, sr]),
+             (-tw[:, sl], shown[:, sl]))
+    yaw = np.full(len(default), np.nan)
+    for vec, ok in cands:
+        right_w = np.nan_to_num(vec) @ cam.R  # camera axes -> world
+        ok = ok & np.isnan(yaw) & (np.hypot(right_w[:, 0], right_w[:, 1]) > 1e-6)
+        yaw[ok] = np.arctan2(right_w[ok, 1], right_w[ok, 0])
+    ok = np.isfinite(yaw)
+    if not ok.any():
+        return default
+    yaw[ok] = np.unwrap(yaw[ok])
+    return fill(yaw, fallback=0.0)
 
 
 #: Chains lifted from 2D, parent target before child (see :func:`_lift`).
@@ -440,10 +517,13 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
     if not set_floor and opt.sigma_floor > 0:
         _floor_terms(model, terms, tc, names)
     params0 = _initial_params(model, camera, names, tx, tc, tw)
-    if tw is not None and opt.depth is not None:
-        # Decide which side of the image plane each arm segment lies on before
-        # the continuous solve, which only refines the side it starts on.
-        tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth)
+    if tw is not None:
+        tw = _impute_shoulders(model, camera, params0, names, tc, tw)
+        if opt.depth is not None:
+            # Decide which side of the image plane each arm segment lies on
+            # before the continuous solve, which only refines the side it
+            # starts on.
+            tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth)
         _, terms.dirs, terms.wd = _direction_terms(names, tc, tw)
         params0 = _initial_params(model, camera, names, tx, tc, tw)
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)

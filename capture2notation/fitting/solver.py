@@ -73,6 +73,14 @@ class FitOptions:
         symbol agreement through BlazePose fell by 4–7 points.
     sigma_rest, sigma_twist : float
         Spread of the pull to the rest pose for swings and for twists, radians.
+    sigma_spine_twist : float
+        Spread of the pull of the waist's and chest's turns to zero, radians:
+        the hips then face where the shoulders do unless the hips are seen
+        to turn.  In a side view the hips are often hidden (a hanging arm
+        covers the near one, the body the far one) and nothing else measures
+        the pelvis's turn; it wandered 30–40° off, twisted against the
+        shoulders, and took every leg direction (which is read in the hips'
+        frame) with it.
     sigma_pelvis, sigma_trunk : float
         Spread of the pull of the pelvis, and of the waist and chest, to
         upright (their tilts, not the turns), radians.  A single view
@@ -130,6 +138,7 @@ class FitOptions:
     sigma_pelvis: float = 0.1
     sigma_trunk: float = 0.2
     sigma_twist: float = 2.0
+    sigma_spine_twist: float = 0.3
     huber: float = 2.0
     spread_deg: float = 0.0
     iterations: int = 20
@@ -267,8 +276,9 @@ def _prior_precision(model: PoseModel, fps: float, opt: FitOptions, T: int):
     rest[3:][twist] = 1.0 / opt.sigma_twist**2
     # The pelvis may face any way, but it and the spine stay near upright.
     rest[3:][model.dof_joint == 0] = np.where(model.dof_axis[model.dof_joint == 0] == 2, 0.0, 1.0 / opt.sigma_pelvis**2)
-    spine = np.isin(model.dof_joint, [JOINTS.index("waist"), JOINTS.index("chest")]) & (model.dof_axis != 2)
-    rest[3:][spine] = 1.0 / opt.sigma_trunk**2
+    in_spine = np.isin(model.dof_joint, [JOINTS.index("waist"), JOINTS.index("chest")])
+    rest[3:][in_spine & (model.dof_axis != 2)] = 1.0 / opt.sigma_trunk**2
+    rest[3:][in_spine & (model.dof_axis == 2)] = 1.0 / opt.sigma_spine_twist**2
     return smooth, rest
 
 
