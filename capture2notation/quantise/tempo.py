@@ -6,13 +6,25 @@ frame), so the beat grid has no free phase: only the period is estimated.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
 
 from ..errors import QuantiseError
 
-__all__ = ["DURATION_OCTAVES", "LEVEL_WEIGHTS", "OUTLIER_RATE", "TEMPO_RANGE", "estimate_tempo", "snap"]
+__all__ = [
+    "DANCE_TEMPO_BPM",
+    "DURATION_OCTAVES",
+    "LEVEL_WEIGHTS",
+    "OUTLIER_RATE",
+    "TEMPO_RANGE",
+    "TempoEstimate",
+    "estimate_tempo",
+    "estimate_tempo_detail",
+    "snap",
+    "tempo_log_prior",
+]
 
 #: Tempi considered by :func:`estimate_tempo`, beats per minute; the emotion
 #: presets of DESIGN.md span 37–80 bpm.
@@ -21,9 +33,39 @@ TEMPO_RANGE = (30.0, 160.0)
 #: around one beat: ½ and 2 beats are 1.3 σ away, so doubling the tempo
 #: costs 0.9 nats per movement.
 DURATION_OCTAVES = 0.75
-#: Centre of the weak log-normal tempo prior (bpm; one octave either side
-#: covers the emotion presets and the random scores' 60-120).
-_PRIOR_BPM = 80.0
+#: Tempi of dance, bpm, equally likely a priori: from the slowest emotion
+#: preset of DESIGN.md (sad, 37 bpm, after Neagle) to quick allegro
+#: exercises (about 132 bpm; this upper end is our assumption about class
+#: music, not a cited figure).  Outside, half or double a tempo is the less
+#: likely reading; inside, the durations and timing decide.
+DANCE_TEMPO_BPM = (36.0, 132.0)
+#: Standard deviation (octaves) of the half-normal fall-off of the tempo
+#: prior outside :data:`DANCE_TEMPO_BPM`.
+TEMPO_PRIOR_OCTAVES = 0.3
+#: Share of movement durations that lie anywhere (spurious or merged
+#: measured movements), spread evenly over _DURATION_SPAN_OCTAVES octaves
+#: of duration.
+DURATION_OUTLIER_RATE = 0.2
+_DURATION_SPAN_OCTAVES = 6.0
+
+
+def tempo_log_prior(tempi) -> np.ndarray:
+    """Log prior density (up to a constant) of tempi, flat over :data:`DANCE_TEMPO_BPM`.
+
+    Parameters
+    ----------
+    tempi : array_like
+        Beats per minute (> 0).
+
+    Returns
+    -------
+    ndarray
+        0 inside the range, ``-½ (octaves outside / TEMPO_PRIOR_OCTAVES)²`` outside.
+    """
+    x = np.log2(np.asarray(tempi, dtype=float))
+    lo, hi = np.log2(DANCE_TEMPO_BPM[0]), np.log2(DANCE_TEMPO_BPM[1])
+    out = np.maximum(lo - x, 0.0) + np.maximum(x - hi, 0.0)
+    return -0.5 * (out / TEMPO_PRIOR_OCTAVES) ** 2
 
 
 def snap(seconds, tempo, grid: Fraction) -> Fraction:
@@ -50,7 +92,7 @@ def snap(seconds, tempo, grid: Fraction) -> Fraction:
     return max(k, 0) * Fraction(grid)
 
 
-def estimate_tempo(
+def estimate_tempo_detail(
     key_times,
     grid: Fraction = Fraction(1, 4),
     tempo_range: tuple[float, float] = TEMPO_RANGE,
@@ -75,7 +117,7 @@ def estimate_tempo(
     in beats they lie log-normally around one beat (:data:`DURATION_OCTAVES`),
     which settles the factor-of-two ambiguity that the key times leave (a
     phrase of half-beat times fits twice its tempo as well); a weak
-    log-normal prior (one octave around :data:`_PRIOR_BPM`) covers the rest.  The best candidate is refined by
+    prior flat over the tempi of dance music (:data:`DANCE_TEMPO_BPM`) covers the rest.  The best candidate is refined by
     least squares of the times on their grid positions, then the whole (or
     half) bpm next to it that the times favour.
 
@@ -111,8 +153,8 @@ def estimate_tempo(
 
     Returns
     -------
-    Fraction
-        Beats per minute, whole or half.
+    TempoEstimate
+        The tempo (whole or half bpm), the runner-up reading and the confidence.
     """
     t = np.asarray(key_times, dtype=float)
     g = np.zeros(t.shape, int) if groups is None else np.asarray(groups, dtype=int)
@@ -131,14 +173,69 @@ def estimate_tempo(
     d = None if durations is None else np.asarray(durations, dtype=float)
     if d is not None:
         d = d[np.isfinite(d) & (d > 0)]
-    best = _refine(t, g, float(cand[int(np.argmax(_log_posterior(t, cand, grid, tolerance_s, d, g, max_offset_s)))]), grid, tolerance_s)
-    # Whole bpm, or half a bpm (the half of an odd tempo, e.g. 48.5 for a
-    # phrase of half beats at 97) when the times favour it by more than
-    # :data:`_WHOLE_BPM_NATS`.
+    post = _log_posterior(t, cand, grid, tolerance_s, d, g, max_offset_s)
+    best = _refine(t, g, float(cand[int(np.argmax(post))]), grid, tolerance_s)
+    # The least-squares tempo, to the nearest whole bpm; or half a bpm (the
+    # half of an odd tempo, e.g. 48.5 for a phrase of half beats at 97) when
+    # the times favour it by more than :data:`_WHOLE_BPM_NATS`.
     near = np.unique([np.floor(best), np.ceil(best), round(2.0 * best) / 2.0])
     score = _log_posterior(t, near, grid, tolerance_s, d, g, max_offset_s) + _WHOLE_BPM_NATS * (near == np.round(near))
-    pick = float(near[int(np.argmax(score))])
-    return Fraction(int(round(2 * pick)), 2)
+    pick = Fraction(int(round(2 * float(near[int(np.argmax(score))]))), 2)
+    # Runner-up: the best reading more than _DISTINCT apart (typically half
+    # or double the tempo); confidence: the posterior mass within _DISTINCT
+    # of the pick (the candidates are evenly spaced in bpm).
+    p = np.exp(post - post.max())
+    close = np.abs(np.log(cand / float(pick))) < np.log1p(_DISTINCT)
+    confidence = float(p[close].sum() / p.sum())
+    runner_up = None
+    if np.any(~close):
+        other = _refine(t, g, float(cand[~close][int(np.argmax(post[~close]))]), grid, tolerance_s)
+        runner_up = Fraction(int(round(other)))
+    return TempoEstimate(pick, runner_up, confidence)
+
+
+def estimate_tempo(key_times, grid: Fraction = Fraction(1, 4), **kwargs) -> Fraction:
+    """Estimate the tempo from the times at which movements start and arrive.
+
+    Parameters
+    ----------
+    key_times : (N,) array_like
+        Seconds.
+    grid : Fraction
+        Finest grid of the score, beats.
+    **kwargs
+        As :func:`estimate_tempo_detail`.
+
+    Returns
+    -------
+    Fraction
+        Beats per minute, whole or half: ``estimate_tempo_detail(...).tempo``.
+    """
+    return estimate_tempo_detail(key_times, grid, **kwargs).tempo
+
+
+@dataclass(frozen=True)
+class TempoEstimate:
+    """A tempo estimate with its nearest rival.
+
+    Attributes
+    ----------
+    tempo : Fraction
+        Beats per minute, whole or half.
+    runner_up : Fraction or None
+        Whole bpm of the best reading more than 15 % away (usually half or
+        double `tempo`), for "tempo 72 bpm (or 36)"; None if no other was searched.
+    confidence : float
+        Posterior probability that the tempo is within 15 % of `tempo`, in [0, 1].
+    """
+
+    tempo: Fraction
+    runner_up: Fraction | None
+    confidence: float
+
+
+#: Relative distance beyond which two tempi are different readings.
+_DISTINCT = 0.15
 
 
 #: Preference (nats) for a whole number of beats per minute over a half.
@@ -159,36 +256,64 @@ def _log_posterior(t: np.ndarray, tempi: np.ndarray, grid: Fraction, tolerance_s
     per = []
     for c in shifts:
         tt = np.where(groups != 0, t - c, t) if groups is not None else t
-        per += [_log_likelihood(tt, tempi, sigma, length, grid) for sigma in tolerance_s * np.array([1, 2, 4])]
-    total = np.logaddexp.reduce(np.stack(per), axis=0) - np.log(len(per)) - 0.5 * np.log2(tempi / _PRIOR_BPM) ** 2
+        per += [_log_likelihood(tt, tempi, sigma, length, grid) for sigma in tolerance_s * np.array(_SIGMA_FACTORS)]
+    total = np.logaddexp.reduce(np.stack(per), axis=0) - np.log(len(per)) + tempo_log_prior(tempi)
     if durations is not None and durations.size:
         # Movements last about a beat (the built-in phrases: all one beat;
         # random scores: ½ to 2 beats): each duration is evidence, in beats
         # log-normal around 1 beat, DURATION_OCTAVES wide.
-        beats = durations[None, :] * tempi[:, None] / 60.0
-        total = total - 0.5 * np.sum((np.log2(beats) / DURATION_OCTAVES) ** 2, axis=1)
+        # A share of measured movements are spurious (jitter read as a short
+        # movement) or merged: they are anywhere in log-duration
+        # (:data:`DURATION_OUTLIER_RATE`, spread over _DURATION_SPAN_OCTAVES),
+        # so that a few of them cannot double the tempo on their own.
+        z = np.log2(durations[None, :] * tempi[:, None] / 60.0) / DURATION_OCTAVES
+        typical = np.exp(-0.5 * z**2) / (DURATION_OCTAVES * np.sqrt(2.0 * np.pi))
+        dens = (1.0 - DURATION_OUTLIER_RATE) * typical + DURATION_OUTLIER_RATE / _DURATION_SPAN_OCTAVES
+        total = total + np.sum(np.log(dens), axis=1)
     return total
 
 
 def _refine(t: np.ndarray, g: np.ndarray, tempo: float, grid: Fraction, sigma: float) -> float:
-    """Tempo from a straight-line fit of the key times on their grid positions.
+    """Tempo from a straight-line fit of the key times on their half-beat points.
 
-    Each group of times has its own intercept: measured starts and arrivals
-    are each delayed (or advanced) by about a frame, which a line through 0
-    would read as another tempo.  Times more than 2 σ (at least a quarter
-    grid step) off their grid points are left out; the refinement is kept
-    only within 2 % of `tempo`.
+    Each time is assigned to its nearest half beat (the simplest reading:
+    most movements start and arrive on whole or half beats); times more than
+    :data:`_REFINE_TRIM` beats off it (quarter beats, spurious movements)
+    are left out, as they pull the line more than they inform it.  Each
+    group of times has its own intercept: measured starts and arrivals are
+    each delayed (or advanced) by about a frame, which a line through 0
+    would read as another tempo.  The fit is repeated once from the refined
+    tempo, and kept only within :data:`_REFINE_SPAN` of `tempo`.  (On the
+    development phrases, noisy and captured, this halved the median error of
+    the quarter-grid fit, to about half a bpm.)
     """
-    q = 60.0 / tempo * float(grid)
-    k = np.round(t / q)
-    ok = np.abs(t - k * q) < max(2.0 * sigma, 0.25 * q)
-    if ok.sum() < 3 or np.ptp(k[ok]) < 2:
-        return tempo
-    labels = np.unique(g[ok])
-    design = np.column_stack([k[ok]] + [(g[ok] == lab).astype(float) for lab in labels])
-    coef, *_ = np.linalg.lstsq(design, t[ok], rcond=None)
-    refined = 60.0 * float(grid) / float(coef[0])
-    return refined if abs(refined - tempo) < 0.02 * tempo else tempo
+    start = tempo
+    for _ in range(_REFINE_PASSES):
+        q = 30.0 / tempo  # seconds per half beat
+        k = np.round(t / q)
+        ok = np.abs(t - k * q) < _REFINE_TRIM * 2.0 * q
+        if ok.sum() < 3 or np.ptp(k[ok]) < 2:
+            return tempo
+        labels = np.unique(g[ok])
+        design = np.column_stack([k[ok]] + [(g[ok] == lab).astype(float) for lab in labels])
+        coef, *_ = np.linalg.lstsq(design, t[ok], rcond=None)
+        if coef[0] <= 0:
+            return tempo
+        refined = 30.0 / float(coef[0])
+        if abs(refined - start) > _REFINE_SPAN * start:
+            return tempo
+        tempo = refined
+    return tempo
+
+
+#: Largest relative change of the refinement (beyond it the grid points
+#: were misassigned).
+_REFINE_SPAN = 0.04
+#: Timing errors σ marginalised, in units of the tolerance.
+_SIGMA_FACTORS = (1, 2, 4)
+_REFINE_PASSES = 2
+#: Largest distance (beats) of a time from its half beat in the refinement.
+_REFINE_TRIM = 0.2
 
 
 #: Probabilities that a key time lies on a whole beat, a half beat (between

@@ -10,7 +10,12 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from capture2notation.errors import QuantiseError
-from capture2notation.quantise.tempo import estimate_tempo, snap
+from capture2notation.quantise.tempo import (
+    estimate_tempo,
+    estimate_tempo_detail,
+    snap,
+    tempo_log_prior,
+)
 
 
 def test_snap_rounds_to_the_nearest_grid_point():
@@ -85,3 +90,50 @@ def test_tempo_from_noisy_times_of_a_whole_beat_phrase():
 def test_too_few_times_need_a_given_tempo():
     with pytest.raises(QuantiseError, match="--tempo"):
         estimate_tempo([1.0])
+
+
+# Key times (s) and gesture durations (s) from the whole path (render 25 fps,
+# BlazePose, 3D fit) of a development leg phrase written at 60 bpm: four
+# one-beat gestures and five spurious short ones (jitter of the fitted legs).
+_LEGS60_TIMES = [3.974, 5.028, 2.043, 2.335, 2.719, 3.059, 3.49, 4.205, 3.859, 5.17,
+                 6.948, 7.994, 1.839, 2.99, 3.42, 3.964, 4.4, 4.724, 4.782, 4.985]
+_LEGS60_DURATIONS = [1.054, 0.292, 0.34, 0.715, 1.311, 1.047, 1.151, 0.544, 0.324, 0.203]
+
+
+def test_captured_phrase_with_spurious_short_movements_is_not_doubled():
+    """The spurious short movements used to read 60 bpm as 121 (their
+    durations, at one beat each, pulled the tempo up); with durations
+    robust to outliers and a prior over dance tempi it stays 60."""
+    est = estimate_tempo_detail(_LEGS60_TIMES, tolerance_s=0.08, durations=_LEGS60_DURATIONS,
+                                groups=np.tile([0, 1], 10), max_offset_s=0.12)
+    assert abs(est.tempo - 60) <= 1
+    assert 0.0 < est.confidence <= 1.0 and est.runner_up is not None and abs(est.runner_up - est.tempo) > 9
+
+
+def test_noisy_whole_beat_phrase_keeps_its_whole_bpm():
+    """Truth joints of an 80 bpm arm phrase with 1 cm jitter: the
+    quarter-grid line fit read 82; the half-beat fit gives 80 exactly."""
+    t = [0.0, 1.738, 2.928, 3.788, 4.409, 6.024, 0.0, 0.794, 1.462, 2.286, 3.713, 4.527, 2.193, 3.002, 2.943, 3.821]
+    d = [1.738, 0.86, 1.616, 0.794, 0.824, 0.814, 0.809, 0.879]
+    assert estimate_tempo(t, tolerance_s=0.08, durations=d, groups=np.tile([0, 1], 8), max_offset_s=0.12) == 80
+
+
+@pytest.mark.parametrize("tempo", [60, 72, 96, 120])
+def test_noisy_whole_beat_phrase_is_not_halved(tempo):
+    """One-beat movements on every beat with a frame (40 ms) of timing error
+    and measured (widened) durations: the written tempo, not half of it."""
+    rng = np.random.default_rng(tempo)
+    spb = 60.0 / tempo
+    starts = np.arange(0, 8, dtype=float)
+    t = np.r_[starts, starts + 1] * spb + rng.normal(0.0, 0.04, 16)
+    d = spb * rng.uniform(0.9, 1.3, 8)
+    groups = np.r_[np.zeros(8, int), np.ones(8, int)]
+    est = estimate_tempo(t, tolerance_s=0.08, durations=d, groups=groups, max_offset_s=0.12)
+    assert abs(est / tempo - 1) <= 0.02
+
+
+def test_tempo_prior_is_flat_over_dance_tempi_and_falls_outside():
+    # Flat from the sad preset's 37 bpm (DESIGN.md) to allegro's 132.
+    prior = tempo_log_prior([15, 37, 60, 90, 132, 264])
+    assert prior[1] == prior[2] == prior[3] == prior[4] == 0.0
+    assert prior[0] < -5 and prior[5] < -5
