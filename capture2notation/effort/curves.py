@@ -34,9 +34,9 @@ import numpy as np
 
 from ..body import JOINTS
 from ..errors import EffortError
-from ..notation.model import PART_SEGMENTS
+from ..notation.model import PART_MIDDLE_JOINT, PART_SEGMENTS
 
-__all__ = ["MIN_ANGLE_DEG", "MIN_FRAMES", "SNAP_S", "ProgressCurve", "progress_curve"]
+__all__ = ["MIN_ANGLE_DEG", "MIN_FRAMES", "REACH_MARGIN", "SNAP_S", "ProgressCurve", "limb_reach", "progress_curve"]
 
 #: A movement whose direction turns by less than this is "held" (no curve).
 MIN_ANGLE_DEG = 5.0
@@ -46,6 +46,10 @@ MIN_FRAMES = 4
 #: half a frame of the virtual dancer's 25 Hz source, which starts and ends
 #: movements on the nearest frame.
 SNAP_S = 0.5 / 25.0
+#: Fraction of the straight limb's length an outward Space modulation
+#: reaches (eq. 5.6's "full reach"): a fully straight limb is a singular pose,
+#: so the virtual dancer (``synthetic.limbs.apply_move``) stops 0.1 % short.
+REACH_MARGIN = 0.999
 
 
 @dataclass(frozen=True)
@@ -71,6 +75,11 @@ class ProgressCurve:
         between the endpoints in step with the progress).
     angle : float
         Total angle turned by the segment's direction, radians.
+    outward : (N,) ndarray or None
+        Radial deviation the outward modulation (eq. 5.6) reaches at full
+        depth, ``reach / r_direct − 1`` (≥ 0), for whole limbs; None for
+        parts whose free joint keeps its distance from the bound joint (head,
+        chest, single segments), which cannot show Space.
     """
 
     part: str
@@ -81,6 +90,12 @@ class ProgressCurve:
     weight: np.ndarray
     radial: np.ndarray
     angle: float
+    outward: np.ndarray | None = None
+
+    @property
+    def shows_space(self) -> bool:
+        """True for whole limbs, whose reach the Space modulation changes."""
+        return self.outward is not None
 
 
 def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -138,6 +153,21 @@ def _endpoint(t, times, rel, conf, ok, where, inward: int):
         return rel[i0], conf[i0]
     w = (t - times[i0]) / (times[i1] - times[i0])
     return (1 - w) * rel[i0] + w * rel[i1], min(conf[i0], conf[i1])
+
+
+def limb_reach(joints: np.ndarray, ok: np.ndarray, bound: int, middle: int, free: int) -> float:
+    """Length of the straight limb bound → middle → free, metres (NaN if unmeasured).
+
+    The median of each segment's length over the valid frames `ok` (T,)
+    bool: fitted skeletons keep per-clip bone lengths, and the median shrugs
+    off frames where a joint is lost.
+    """
+    upper = np.linalg.norm(joints[:, middle] - joints[:, bound], axis=1)
+    lower = np.linalg.norm(joints[:, free] - joints[:, middle], axis=1)
+    good = ok & np.isfinite(upper) & np.isfinite(lower)
+    if not good.any():
+        return float("nan")
+    return float(np.median(upper[good]) + np.median(lower[good]))
 
 
 def progress_curve(
@@ -243,6 +273,13 @@ def progress_curve(
     s = arc / total
     r_direct = radius[0] + (radius[-1] - radius[0]) * s
     radial = radius / r_direct - 1.0
+    outward = None
+    middle = names.index(PART_MIDDLE_JOINT[part]) if PART_MIDDLE_JOINT.get(part) in names else -1
+    if middle >= 0:
+        reach = REACH_MARGIN * limb_reach(joints, ok, bound, middle, free)
+        # a limb already straight at both ends (or an unmeasured reach) has
+        # no outward room: depth 0, and Space is read from inward pulls only
+        outward = np.maximum(np.nan_to_num(reach / r_direct[1:-1] - 1.0, nan=0.0), 0.0)
     return ProgressCurve(
         part=part,
         t_start=float(t_start),
@@ -252,4 +289,5 @@ def progress_curve(
         weight=conf[idx],
         radial=radial[1:-1],
         angle=total,
+        outward=outward,
     )

@@ -18,8 +18,8 @@ from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS, Score
 from .curves import SNAP_S, ProgressCurve, progress_curve
 from .emotion import emotion_probabilities, features
-from .fit import SpaceEstimate, fit_space
-from .pooled import PooledEffort, pool_curves
+from .fit import SpaceEstimate
+from .pooled import PooledEffort, curve_space, pool_curves, pooled_space
 from .posterior import Posterior, sample_posteriors
 
 __all__ = ["EffortResult", "MovementEffort", "estimate_effort", "movement_windows"]
@@ -266,14 +266,13 @@ def estimate_effort(
             duration=float(sym.duration),
             curve=c,
             posterior=post,
-            space=fit_space(c.tau, c.radial, c.weight),
+            space=curve_space(c),
         )
         for sym, c, post in zip(syms, curves, posts[:n_mov])
     )
     pooled_all = {}
     for (label, cs), post in zip(groups, posts[n_mov:]):
-        tau, _, w, radial, _ = pool_curves(cs)
-        pooled_all[label] = PooledEffort(label, len(cs), post, fit_space(tau, radial, w))
+        pooled_all[label] = PooledEffort(label, len(cs), post, pooled_space(cs))
     phrase = pooled_all.pop("phrase", None)
     if phrase is not None and len(by_part) == 1 and len(curves) >= 2:
         (only,) = by_part

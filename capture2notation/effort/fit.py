@@ -15,10 +15,24 @@ from scipy import optimize, special, stats
 from ..errors import EffortError
 from .model import TIME_RANGE, WEIGHT_RANGE, progress
 
-__all__ = ["INWARD_DEPTH", "LogisticFit", "SpaceEstimate", "fit_logistic", "fit_logistic_many", "fit_space"]
+__all__ = [
+    "INWARD_DEPTH",
+    "MIN_OUTWARD_DEPTH",
+    "NO_SPACE",
+    "LogisticFit",
+    "SpaceEstimate",
+    "fit_logistic",
+    "fit_logistic_many",
+    "fit_space",
+]
 
 #: Depth of the inward Space modulation at S = 0 (Neagle eq. 5.5: 0.1·r).
 INWARD_DEPTH = 0.1
+#: Smallest mean outward depth (fraction of the radius, see
+#: :attr:`.curves.ProgressCurve.outward`) for which an outward bulge is read
+#: against eq. 5.6; a nearly straight limb has no outward room, and a bulge
+#: there is noise or an inward model's sign error.
+MIN_OUTWARD_DEPTH = 0.005
 
 
 @dataclass(frozen=True)
@@ -55,6 +69,11 @@ class SpaceEstimate:
     ci90: tuple
     amplitude: float
     amplitude_se: float
+
+
+#: Space of a movement that cannot show it (head, chest, single segments
+#: keep the free joint's distance): the uniform prior's median and 90 % interval.
+NO_SPACE = SpaceEstimate(median=0.5, ci90=(0.05, 0.95), amplitude=float("nan"), amplitude_se=float("inf"))
 
 
 def _truncnorm_summary(mu: float, sd: float, lo: float, hi: float, mass: float = 0.9):
@@ -311,18 +330,24 @@ def _ar1_regression(tau, x, y, w, column: int):
     return mean, float(np.sqrt(post @ (var_k + (mean_k - mean) ** 2)))
 
 
-def fit_space(tau, radial, weight=None) -> SpaceEstimate:
-    """Space from the radial deviation: ``radial ≈ c0 + c1·τ + A·sin(πτ)``, ``S = 1 − |A| / 0.1``.
+def fit_space(tau, radial, weight=None, outward=None, groups=None) -> SpaceEstimate:
+    """Space from the radial deviation: ``radial ≈ c0 + c1·τ + A·sin(πτ)``.
 
     Eq. 5.5 pulls the extremity inward by ``(1 − S)·0.1·r·sin(πτ)``, so a
-    direct movement (S = 1) has A = 0 and the most indirect one A = −0.1.
+    direct movement (S = 1) has A = 0 and the most indirect one A = −0.1:
+    ``S = 1 + A / 0.1``.  A limb bent at both ends reaches outward instead
+    (eq. 5.6, ``(1 − S)·(L − r)·sin(πτ)`` with L the full reach): when the
+    bulge is clearly outward and `outward` gives the depth ``L / r − 1`` per
+    sample, the deviation is regressed on ``outward·sin(πτ)``, whose
+    coefficient is ``1 − S``.  Without `outward` an outward bulge is read by
+    its size against 0.1, as indirect as an inward one of the same depth.
     The residuals are AR(1) along each run of increasing τ, as in the
     logistic's likelihood (:mod:`.likelihood`); their correlation ρ is
     marginalised on a grid (:func:`_ar1_regression`).
-    The straight-line terms absorb errors of the direct path's end radii.
-    The uniform prior on S ∈ [0, 1] truncates the Gaussian posterior of A;
-    an outward bulge (A > 0) is read by its size, as indirect as an inward
-    one of the same depth.
+    The straight-line terms absorb errors of the direct path's end radii;
+    pooled movements (`groups`) each get their own, since their end errors
+    differ while the Space is shared.
+    The uniform prior on S ∈ [0, 1] truncates the Gaussian posterior.
 
     Parameters
     ----------
@@ -330,19 +355,44 @@ def fit_space(tau, radial, weight=None) -> SpaceEstimate:
         Normalised time and radial deviation ``r / r_direct − 1``.
     weight : (N,) array_like, optional
         Per-sample confidence.
+    outward : (N,) array_like, optional
+        Outward depth ``L / r_direct − 1`` (≥ 0) per sample
+        (:attr:`.curves.ProgressCurve.outward`).
+    groups : (N,) array_like of int, optional
+        Movement index of each sample when several are pooled.
     """
     tau, y, w = _check(tau, radial, weight)
     if tau.size < 4:
         raise EffortError(f"need at least 4 samples to fit Space, got {tau.size}")
-    x = np.column_stack([np.ones_like(tau), tau, np.sin(np.pi * tau)])
-    amp, se = _ar1_regression(tau, x, y, w, 2)
+    bump = np.sin(np.pi * tau)
+    if groups is None:
+        line = np.column_stack([np.ones_like(tau), tau])
+    else:
+        g = np.asarray(groups)
+        if g.shape != tau.shape:
+            raise EffortError(f"groups must be shaped like tau {tau.shape}, got {g.shape}")
+        onehot = (g[:, None] == np.unique(g)[None, :]).astype(float)  # (N, G)
+        line = np.hstack([onehot, onehot * tau[:, None]])
+    x = np.column_stack([bump, line])
+    amp, se = _ar1_regression(tau, x, y, w, 0)
     # floor: the dancer's own modulation is resolved to ~1e-3 of the radius
     # (S to 0.01); a noise-free render would otherwise give a zero-width interval
     se = float(max(se, 1e-3))
-    # inward (eq. 5.5) is the model; a clear outward bulge (eq. 5.6, bent
-    # limbs) is read by its depth, but noise about zero stays signed so that
-    # a direct movement is not pushed below S = 1
-    mu = 1.0 - abs(amp) / INWARD_DEPTH if amp > 3.0 * se else 1.0 + amp / INWARD_DEPTH
-    sd = se / INWARD_DEPTH
+    clear_out = amp > 3.0 * se
+    depth = None
+    if outward is not None:
+        depth = np.asarray(outward, dtype=float)
+        if depth.shape != tau.shape or not np.all(np.isfinite(depth)):
+            raise EffortError(f"outward depth must be finite and shaped like tau {tau.shape}, got {depth.shape}")
+    if clear_out and depth is not None and np.average(depth * bump, weights=w) > MIN_OUTWARD_DEPTH:
+        x[:, 0] = depth * bump
+        k, k_se = _ar1_regression(tau, x, y, w, 0)
+        # same floor as below: S resolved to 0.01
+        mu, sd = 1.0 - k, float(max(k_se, 1e-3 / INWARD_DEPTH))
+    else:
+        # inward (eq. 5.5) is the model; noise about zero stays signed so
+        # that a direct movement is not pushed below S = 1
+        mu = 1.0 - abs(amp) / INWARD_DEPTH if clear_out else 1.0 + amp / INWARD_DEPTH
+        sd = se / INWARD_DEPTH
     lo, med, hi = _truncnorm_summary(mu, sd, 0.0, 1.0)
     return SpaceEstimate(median=med, ci90=(lo, hi), amplitude=amp, amplitude_se=se)

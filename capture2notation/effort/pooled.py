@@ -15,10 +15,10 @@ import numpy as np
 
 from ..errors import EffortError
 from .curves import ProgressCurve
-from .fit import SpaceEstimate, fit_space
+from .fit import NO_SPACE, SpaceEstimate, fit_space
 from .posterior import Posterior, sample_posterior
 
-__all__ = ["PooledEffort", "pool_curves", "pooled_posterior"]
+__all__ = ["PooledEffort", "curve_space", "pool_curves", "pooled_posterior", "pooled_space"]
 
 
 @dataclass(frozen=True)
@@ -55,6 +55,29 @@ def pool_curves(curves) -> tuple:
     return (*cat, groups)
 
 
+def curve_space(curve: ProgressCurve) -> SpaceEstimate:
+    """Space of one movement; :data:`.fit.NO_SPACE` for parts that cannot show it."""
+    if not curve.shows_space:
+        return NO_SPACE
+    return fit_space(curve.tau, curve.radial, curve.weight, curve.outward)
+
+
+def pooled_space(curves) -> SpaceEstimate:
+    """Shared Space of `curves`, from the whole limbs among them only.
+
+    A head or single-segment movement keeps its radius whatever the Space
+    (the dancer modulates the reach of whole limbs), so pooling its flat
+    radial deviation would pull every phrase towards S = 1.
+
+    Returns :data:`.fit.NO_SPACE` when no whole limb moved.
+    """
+    limbs = [c for c in curves if c.shows_space]
+    if not limbs:
+        return NO_SPACE
+    tau, _, w, radial, groups = pool_curves(limbs)
+    return fit_space(tau, radial, w, np.concatenate([c.outward for c in limbs]), groups)
+
+
 def pooled_posterior(curves, label: str, rng, **kw) -> PooledEffort:
     """Sample the shared posterior of `curves`.
 
@@ -68,6 +91,6 @@ def pooled_posterior(curves, label: str, rng, **kw) -> PooledEffort:
         Passed to :func:`.posterior.sample_posterior`.
     """
     curves = list(curves)
-    tau, s, w, radial, groups = pool_curves(curves)
+    tau, s, w, _, groups = pool_curves(curves)
     post = sample_posterior(tau, s, w, rng=rng, groups=groups, **kw)
-    return PooledEffort(label=label, n_movements=len(curves), posterior=post, space=fit_space(tau, radial, w))
+    return PooledEffort(label=label, n_movements=len(curves), posterior=post, space=pooled_space(curves))
