@@ -279,22 +279,33 @@ def estimate_effort(joints, confidence, fps: float, score: Score, kept: np.ndarr
         return {"time": nan3, "weight": nan3, "space": nan3, "movements": len(curves)}
 
     def pooled(sel):
-        return tuple(np.concatenate([getattr(curves[i], k) for i in sel]) for k in ("tau", "s", "weight", "radial"))
+        return tuple(np.concatenate([getattr(curves[i], k) for i in sel]) for k in ("tau", "s", "weight"))
 
-    tau, s, w, rad = pooled(np.arange(len(curves)))
+    def space(sel):
+        # Only whole limbs show Space (a head keeps its radius); each pooled
+        # movement keeps its own straight-line trend (capture2notation.effort).
+        sel = [i for i in sel if curves[i].shows_space]
+        if not sel:
+            return np.nan
+        tau, rad, w, out = (np.concatenate([getattr(curves[i], k) for i in sel])
+                            for k in ("tau", "radial", "weight", "outward"))
+        groups = np.concatenate([np.full(len(curves[i].tau), g) for g, i in enumerate(sel)])
+        return fit_space(tau, rad, w, outward=out, groups=groups).median
+
+    tau, s, w = pooled(np.arange(len(curves)))
     lf = fit_logistic(tau, s, w)
-    est = (lf.b, lf.x0, fit_space(tau, rad, w).median)
+    est = (lf.b, lf.x0, space(range(len(curves))))
     boots = []
     for _ in range(bootstrap):
         sel = rng.integers(0, len(curves), len(curves))
-        tau, s, w, rad = pooled(sel)
+        tau, s, w = pooled(sel)
         # One warm start from the full fit: resamples stay near it, and the
         # multi-start search of fit_logistic would cost 4x as much.
         r = optimize.least_squares(
             lambda p, tau=tau, s=s, sw=np.sqrt(w): sw * (progress(tau, p[0], p[1]) - s), [lf.b, lf.x0],
             bounds=([TIME_RANGE[0], WEIGHT_RANGE[0]], [TIME_RANGE[1], WEIGHT_RANGE[1]]), x_scale=[1.0, 0.1],
         )
-        boots.append((r.x[0], r.x[1], fit_space(tau, rad, w).median))
+        boots.append((r.x[0], r.x[1], space(sel)))
     boots = np.array(boots, dtype=float).reshape(-1, 3)
     lo = np.quantile(boots, 0.05, axis=0) if bootstrap else np.array(est)
     hi = np.quantile(boots, 0.95, axis=0) if bootstrap else np.array(est)
