@@ -22,7 +22,9 @@ Noisy motion (fitted, mocap)
     Savitzky–Golay smoothing over 0.3–0.6 s (wider for more jitter); a
     movement exceeds the jitter's 99th-percentile speed and peaks above
     ``peak_speed_deg_s`` (hysteresis), splits at interior minima deeper than
-    ``split_ratio``, must move ``min_amplitude_deg``.  Its start and arrival
+    ``split_ratio`` (shallower ones too where the part passes near a written
+    pose, :data:`_NEAR_POSE_DEG`: smoothing fills the dip between chained
+    half-beat movements), must move ``min_amplitude_deg``.  Its start and arrival
     are those of the Effort logistic fitted to its raw progress
     (:mod:`.timing`) — a speed threshold cuts a fifth to a third off each
     end — and it must last :data:`_MIN_MOVE_S` or hold its arrival pose for
@@ -30,7 +32,9 @@ Noisy motion (fitted, mocap)
     fit); its label is the mean pose over up to :data:`_HOLD_S` of
     the hold after the arrival, and it is written only when that label
     differs from the part's previous one.  Key times of different parts
-    within ``merge_window_s`` are pulled together.  Feet contacts come from
+    within ``merge_window_s`` are pulled together.  A fitted chest is read
+    from its own upright and must tilt past the fit's trunk noise
+    (:func:`~.measured.upright_trunk`).  Feet contacts come from
     smoothed joints (:func:`~.supports.smooth_positions`).
 
 Whole limb or segments
@@ -66,6 +70,7 @@ from scipy.signal import savgol_filter
 from ..errors import QuantiseError
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
+from .measured import upright_trunk
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .spans import _ZERO_SPEED, movement_spans
 from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
@@ -173,6 +178,12 @@ _CLEAN_NOISE_DEG = 0.05
 #: logistic): half a beat at 150 bpm; anything quicker is a glitch of the
 #: fit (a flip of depth, a swapped limb), not a dance movement.
 _MIN_MOVE_S = 0.2
+#: A noisy part this near (degrees) a written direction may end a movement
+#: at a shallow speed minimum (:func:`~.spans.movement_spans`): two thirds
+#: of the 22.5° to a sector boundary, where a 45° movement's mid-way pose lies.
+_NEAR_POSE_DEG = 15.0
+#: Tilt from vertical where a trunk part leaves place high (DESIGN.md).
+_TILT_DEG = 22.5
 #: Longest hold after a noisy arrival over which the pose is averaged, seconds.
 _HOLD_S = 0.4
 
@@ -381,6 +392,12 @@ def _label_at(labels: FrameLabels, col: int, frames: slice) -> tuple[str, str, i
     return DIRECTION_NAMES[d[0]], LEVELS[lv[0]], bend
 
 
+def _tilt_deg(labels: FrameLabels, col: int, frames: slice) -> float:
+    """Angle of a column's mean vector over `frames` from vertical, degrees."""
+    v = np.nanmean(labels.vectors[frames, col], axis=0)
+    return float(np.degrees(np.arccos(np.clip(v[2] / np.linalg.norm(v), -1.0, 1.0))))
+
+
 def _off_canonical_deg(labels: FrameLabels, col: int, frames: slice) -> float:
     """Angle from the mean vector of a column to its label's canonical vector, degrees."""
     from ..notation.directions import canonical_vector
@@ -566,7 +583,12 @@ def _gesture_movements(
     T = labels.direction.shape[0]
     # Noisy poses are averaged over up to this long a hold after the arrival.
     hold = max(1, int(round(_HOLD_S * fps)))
+    all_labels = labels
     for part in tuple(_LIMBS) + _SINGLE:
+        labels, margin = all_labels, 0.0
+        if measured and part == "chest":
+            # A fitted chest leans by a bias of its own (see .measured).
+            labels, margin = upright_trunk(all_labels, part)
         whole = labels.index(part)
         u_list, reach, bend_list = _channel(labels, joints, part)
         noise = max([_noise_deg(u) for u in u_list] + [_scalar_noise(x) for x in bend_list])
@@ -596,7 +618,10 @@ def _gesture_movements(
             speed = np.where(down[:-1] & down[1:], 0.0, speed)
         arrivals = _weight_arrivals(joints) if clean and part in _FOOT else None
         key = _key_pose_fn(labels, part, on_grid, arrivals=arrivals) if clean else None
-        spans = movement_spans(speed, low, high, params.split_ratio, key_pose=key)
+        # Noisy motion: a shallower minimum parts two movements where the
+        # part passes within _NEAR_POSE_DEG of a written pose.
+        near = None if clean else _off_canonical_series(u_list[0]) < _NEAR_POSE_DEG
+        spans = movement_spans(speed, low, high, params.split_ratio, key_pose=key, near_pose=near)
         state = _DEFAULT.get(part, ("place", "low")) + (0,)
         for i, (a, b) in enumerate(spans):
             start_f, end_f = a, min(b + 1, T - 1)
@@ -642,6 +667,9 @@ def _gesture_movements(
                 continue
             if part not in _LIMBS:
                 bend = 0
+                if margin and _tilt_deg(labels, whole, frames) < _TILT_DEG + margin:
+                    # Within the fit's own trunk noise of upright.
+                    d, lv = _DEFAULT[part]
             if (d, lv, bend) == state:
                 continue
             state = (d, lv, bend)

@@ -13,10 +13,14 @@ __all__ = ["movement_spans"]
 #: Speeds below this (degrees per second) are rounding noise of a hold, not
 #: movement; a sudden Effort's first frame still moves far more.
 _ZERO_SPEED = 1e-6
+#: Split ratio of a noisy speed minimum where the part is near a written pose
+#: (see :func:`movement_spans`).
+NEAR_POSE_SPLIT_RATIO = 0.6
 
 
 def movement_spans(
-    speed: np.ndarray, low: float, high: float, split_ratio: float, key_pose=None
+    speed: np.ndarray, low: float, high: float, split_ratio: float, key_pose=None, near_pose=None,
+    near_ratio: float = NEAR_POSE_SPLIT_RATIO,
 ) -> list[tuple[int, int]]:
     """Movements in a per-interval speed signal.
 
@@ -36,6 +40,15 @@ def movement_spans(
         the local speed minima it accepts, however shallow, and never
         elsewhere — a limb passing near its turning axis slows down
         mid-movement without arriving anywhere.
+    near_pose : (N + 1,) ndarray of bool, optional
+        Noisy motion: frames where the part is near a written pose.  A
+        minimum whose boundary frame is there splits when shallower than
+        `near_ratio` (instead of `split_ratio`): smoothing over 0.3-0.6 s
+        fills the dip between a half-beat movement and the next one that
+        leaves at once, but the pose between them is a written one.  (A
+        single movement's speed has one peak: its noisy dips are shallower,
+        and only a 45° movement's mid-way pose lies far from any written one.)
+    near_ratio : float
 
     Returns
     -------
@@ -63,7 +76,7 @@ def movement_spans(
             b += 1
         taken[a : b + 1] = True
         if key_pose is None:
-            for lo, hi in _split(s, a, b, split_ratio, high):
+            for lo, hi in _split(s, a, b, split_ratio, high, near_pose, near_ratio):
                 # Noisy motion: the walk down may run far into smoothed jitter,
                 # so each movement keeps only where it exceeds a tenth of its peak.
                 idx = np.flatnonzero(s[lo : hi + 1] >= 0.1 * s[lo : hi + 1].max())
@@ -109,8 +122,10 @@ def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> 
     return out
 
 
-def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float) -> list[tuple[int, int]]:
-    """Split interval range [a, b] at its deepest qualifying interior minimum, recursively."""
+def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float, near=None,
+           near_ratio: float = 0.0) -> list[tuple[int, int]]:
+    """Split interval range [a, b] at its deepest qualifying interior minimum, recursively
+    (`near`, `near_ratio`: see :func:`movement_spans`)."""
     if b - a < 2:
         return [(a, b)]
     seg = s[a : b + 1]
@@ -122,10 +137,12 @@ def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float) -> list[tup
         if min(left, right) <= high:
             continue
         depth = seg[k] / min(left, right)
-        if depth < ratio and (best_depth is None or depth < best_depth):
+        # Interval k ends at frame a + k + 1, where the next movement would start.
+        limit = near_ratio if near is not None and near[a + k + 1] else ratio
+        if depth < max(ratio, limit) and (best_depth is None or depth < best_depth):
             best, best_depth = k, depth
     if best is None:
         return [(a, b)]
     m = a + int(best)
     # The minimum interval holds the boundary: it closes the first movement.
-    return _split(s, a, m, ratio, high) + _split(s, m + 1, b, ratio, high)
+    return _split(s, a, m, ratio, high, near, near_ratio) + _split(s, m + 1, b, ratio, high, near, near_ratio)

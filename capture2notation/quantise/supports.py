@@ -25,12 +25,19 @@ Noisy motion (fitted joints, mocap: jitter above :data:`NOISY_POSITION_M`)
 has speeds as large as a plié's from the jitter alone, so there the
 movements are the changes of the mode-filtered support state instead,
 timed by the Effort logistic fitted to the pelvis
-(:func:`_noisy_support_movements`).
+(:func:`_noisy_support_movements`).  A single-view fit also floats and
+sinks the feet by centimetres and barely bends a knee seen from the front,
+so there a foot flickering out of contact with the pelvis still between
+the feet keeps supporting (:func:`_balanced_contacts`), pliés are read from
+the pelvis height (:func:`_pelvis_plie`), a step must move the foot with
+the weight following (:func:`_plausible_step`), and the flight of a step
+belongs to the step (:func:`_join_flights`).
 """
 
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -277,7 +284,9 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
 
     T = joints.shape[0]
     smooth = smooth_positions(joints, fps)
+    labels = _balanced_contacts(labels, smooth, fps)
     part, level = support_state(labels, smooth)
+    level = _pelvis_plie(part, level, smooth)
     grounded = float(np.mean(part >= 0))
     if grounded < MIN_GROUNDED:
         # Our vocabulary has no jumps: feet found on the floor this rarely
@@ -290,11 +299,14 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     min_len = max(1, int(round(MIN_SUPPORT_S * fps)))
     runs = [r for r in _runs(code) if r[0] >= 4 and r[2] - r[1] + 1 >= min_len]  # grounded only
     height = _body_height(smooth)
+    offset = _standing_foot_offset(smooth, labels.supporting)
     pelvis = joints[:, joint_index("pelvis")]
     out = []
     state = (0, LEVELS.index("middle"), "place")
     # The run the next movement leaves (before the first: standing from frame 0).
     prev_start, prev_end = 0, 0
+    # Last frame each foot bore weight in a grounded run.
+    bore = {0: 0, 1: 0}
     for c, a, b in runs:
         new_part, new_level = c // 4 - 1, c % 4 - 1
         # A step needs a flight: a weight-bearing foot off the floor between
@@ -303,8 +315,16 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         # Before the first grounded run nothing says where the feet were (a
         # fit finding the floor late), so that run is never a step.
         flew = bool(out) or prev_end > 0
-        flew = flew and any((~labels.supporting[prev_end : a + 1, f]).sum() >= 2 for f in feet)
-        direction = _step_direction(smooth, labels, prev_end, a, new_part, height) if flew else "place"
+        # A step onto one foot travels from where that foot last bore weight
+        # (across the run on the other foot that carries its flight); a
+        # closing (both feet) is judged from the run it leaves, whose pelvis
+        # is already over the foot that stays.
+        since = {f: min(prev_end, bore[f]) if new_part > 0 else prev_end for f in feet}
+        flew = flew and any((~labels.supporting[since[f] : a + 1, f]).sum() >= 2 for f in feet)
+        land = (a + b) // 2  # the smoothed foot is still landing at the run's first frame
+        direction = _step_direction(smooth, labels, prev_end, land, new_part, height, offset, since) if flew else "place"
+        for f in feet:
+            bore[f] = b
         new = (new_part, new_level, direction)
         if new[:2] == state[:2] and direction == "place":
             prev_start, prev_end = a, b
@@ -312,6 +332,10 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         # Window: from the middle of the hold left to the middle of this one.
         lo, hi = (prev_start + prev_end) // 2, min((a + b) // 2 + 1, T - 1)
         win = _pelvis_window(pelvis, lo, prev_end, a, hi, fps)
+        if win is None:
+            # A slow movement (a plié over two beats) moves the pelvis through
+            # the inner halves of both holds: compare their outer halves.
+            win = _pelvis_window(pelvis, prev_start, lo, hi, b, fps)
         if win is None:
             # The pelvis did not move: contact flicker, not a support change.
             continue
@@ -321,7 +345,122 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         state = new
         out.append(Movement(_SUPPORT_PARTS[new_part], start, end, max(t0, 0.0), t1, direction, LEVELS[new_level], 0))
         prev_start, prev_end = a, b
+    return _join_flights(out)
+
+
+#: A weight transfer onto one foot that the other foot's step follows
+#: within this many seconds (no hold between) is that step's flight.
+FLIGHT_GAP_S = 0.5
+
+
+def _join_flights(moves: list) -> list:
+    """Support movements with each step's flight made part of the step.
+
+    While one foot swings through a step the weight is on the other foot
+    alone, and a slow step holds that state long enough to be a grounded
+    run of its own: ``left_support place`` then ``right_support forward``.
+    A notator writes the step from the moment the weight leaves: when the
+    step onto the other foot follows within :data:`FLIGHT_GAP_S` (the
+    pelvis never settled), the transfer is dropped and the step starts
+    where it started.
+    """
+    out: list = []
+    for m in moves:
+        prev = out[-1] if out else None
+        if (prev is not None and m.direction != "place" and prev.direction == "place"
+                and {prev.part, m.part} == {"right_support", "left_support"}
+                and m.start_time - prev.end_time < FLIGHT_GAP_S):
+            out[-1] = replace(m, start_frame=prev.start_frame, start_time=prev.start_time)
+            continue
+        out.append(m)
     return out
+
+
+#: A fitted foot counted off the floor while the pelvis stays between the
+#: feet supports after all when its lowest point is within this of the
+#: other (supporting) foot's, metres.
+BALANCE_FOOT_M = 0.08
+#: Pelvis lowered below its standing height by this fraction of the body
+#: height is a plié: knees bent 30° (DESIGN.md) lower a 1.70 m dancer's
+#: pelvis 2.8 cm.
+PLIE_DROP_FRACTION = 0.0165
+
+
+def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> FrameLabels:
+    """Contacts of measured feet, with a foot that flickers off the floor while it still carries weight put back.
+
+    A fitted foot floats or sinks by a few centimetres (a relevé's toes
+    rise 3-7 cm in a front view, a plié sinks the feet), so one foot of
+    two can leave the 3 cm contact band while both stand: the support read
+    as one foot (``right_support place high`` for a relevé).  But the
+    weight can rest on one foot only with the pelvis over it
+    (:func:`weight_bearing` asks for it within a quarter of the way to the
+    other foot): a foot out of contact, slow, near the supporting foot's
+    height (:data:`BALANCE_FOOT_M`) while the pelvis stays between the
+    feet supports too.
+
+    Parameters
+    ----------
+    labels : FrameLabels
+    joints : (T, J, 3) ndarray
+        Smoothed joints (:func:`smooth_positions`).
+    fps : float
+
+    Returns
+    -------
+    FrameLabels
+        With the completed contacts (a restored foot at the other foot's level).
+    """
+    from .labels import with_supports
+
+    sup = np.asarray(labels.supporting, bool)
+    if sup.shape[0] < 2:
+        return labels
+    pelvis = joints[:, joint_index("pelvis"), :2]
+    low, mid = [], []
+    for side in ("right", "left"):
+        a, t = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
+        low.append(np.fmin(a[:, 2], t[:, 2]))
+        mid.append(0.5 * (a + t))
+    d = mid[1][:, :2] - mid[0][:, :2]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.sum((pelvis - mid[0][:, :2]) * d, axis=-1) / np.sum(d * d, axis=-1)
+    between = (u > 0.25) & (u < 0.75)
+    out = sup.copy()
+    for k in range(2):
+        step = np.linalg.norm(np.diff(mid[k], axis=0), axis=-1) * fps
+        speed = np.r_[step[:1], np.fmin(step[1:], step[:-1]), step[-1:]] if step.size > 1 else np.zeros(len(sup))
+        near = np.abs(low[k] - low[1 - k]) < BALANCE_FOOT_M
+        out[:, k] |= sup[:, 1 - k] & ~sup[:, k] & between & near & (speed < 0.2)
+    if np.array_equal(out, sup):
+        return labels
+    # A restored foot stands at the level of the foot it shares the weight with.
+    other = labels.support_level[:, ::-1]
+    level = np.where(sup, labels.support_level, np.where(out, other, -1))
+    return with_supports(labels, out, level)
+
+
+def _pelvis_plie(part: np.ndarray, level: np.ndarray, joints: np.ndarray) -> np.ndarray:
+    """Support levels of measured motion with pliés read from the pelvis height, not the knees.
+
+    Seen from the front a fitted knee hardly bends in a plié (45° read as
+    20-26°, standing 15°: the flexion is in depth), yet bends past 30° on
+    a straight-legged landing; the pelvis drops as far as the dancer's (6 cm
+    in a 45° plié).  A supported frame not in relevé is low exactly when its
+    pelvis is :data:`PLIE_DROP_FRACTION` of the body height below the
+    standing height (the knees bent 30°), taken as the 75th percentile of the
+    pelvis height over the supported frames not in relevé: a phrase stands
+    for at least a quarter of them.  Fewer than five such frames leave the
+    levels alone.
+    """
+    z = joints[:, joint_index("pelvis"), 2]
+    high, low = LEVELS.index("high"), LEVELS.index("low")
+    flat = (part >= 0) & (level != high) & np.isfinite(z)
+    if flat.sum() < 5:
+        return level
+    ref = float(np.percentile(z[flat], 75))
+    drop = PLIE_DROP_FRACTION * _body_height(joints)
+    return np.where(flat, np.where(z < ref - drop, low, LEVELS.index("middle")), level)
 
 
 def _pelvis_window(pelvis: np.ndarray, lo: int, a: int, b: int, hi: int, fps: float):
@@ -397,27 +536,82 @@ def _body_height(joints: np.ndarray) -> float:
     return float(leg) / (0.530 - 0.039)
 
 
-def _step_direction(joints, labels: FrameLabels, a: int, k: int, part: int, height: float) -> str:
-    """``place``, or the direction a weight-bearing foot stepped between frames a and k."""
+def _standing_foot_offset(joints: np.ndarray, contact: np.ndarray) -> np.ndarray:
+    """(2, 3) horizontal offset of each ankle from its hip while both feet stand, metres (median).
+
+    Standing, each foot is under its hip (DESIGN.md), so this is 0 for the
+    dancer; a single-view fit places the feet several centimetres off in
+    depth (10 cm behind the hips in a front view), which shortened a
+    30 cm step forward under the half-step threshold.  Zero where no frame
+    stands on both feet.
+    """
+    out = np.zeros((2, 3))
+    both = np.asarray(contact, bool).all(axis=1)
+    if both.sum() < 5:
+        return out
+    for f, side in enumerate(("right", "left")):
+        d = joints[both, joint_index(f"{side}_ankle")] - joints[both, joint_index(f"{side}_hip")]
+        out[f, :2] = np.nanmedian(d[:, :2], axis=0)
+    return np.where(np.isfinite(out), out, 0.0)
+
+
+#: Measured step: the pelvis follows the stepping foot by at least this
+#: fraction of the foot's travel (the weight goes where the foot went).
+STEP_PELVIS_FOLLOWS = 0.3
+
+
+def _plausible_step(joints: np.ndarray, f: int, a: int, k: int, height: float) -> bool:
+    """Whether foot `f` (0 right, 1 left) stepped between frames a and k of measured motion.
+
+    A fitted supporting foot that flickers off the floor while the pelvis
+    pushes away from it looks, against its hip, like a step the other way
+    (``right_support right`` during a step to the left).  A step moves the
+    foot itself at least half a step (:data:`STEP_MIN_FRACTION` of the
+    height), and the weight follows it (:data:`STEP_PELVIS_FOLLOWS`).
+    """
+    side = ("right", "left")[f]
+    travel = (joints[k, joint_index(f"{side}_ankle")] - joints[a, joint_index(f"{side}_ankle")])[:2]
+    dist = float(np.linalg.norm(travel))
+    if not dist >= STEP_MIN_FRACTION * height:
+        return False
+    pelvis = (joints[k, joint_index("pelvis")] - joints[a, joint_index("pelvis")])[:2]
+    return float(pelvis @ travel) / dist >= STEP_PELVIS_FOLLOWS * dist
+
+
+def _step_direction(joints, labels: FrameLabels, a: int, k: int, part: int, height: float,
+                    offset: np.ndarray | None = None, starts: dict | None = None) -> str:
+    """``place``, or the direction a weight-bearing foot stepped between frames a and k.
+
+    `offset` (2, 3): each foot's standing offset from its hip in the
+    measurement (:func:`_standing_foot_offset`), removed first.  `starts`
+    (foot index → frame; measured motion): where each foot's travel is
+    measured from instead of `a` (the last frame it bore weight), and a
+    foot steps only if :func:`_plausible_step`.
+    """
     feet = {0: (0, 1), 1: (0,), 2: (1,)}[part]
     best, best_d = None, STEP_MIN_FRACTION * height
     R = None
     for f in feet:
         side = ("right", "left")[f]
+        af = a if starts is None else starts.get(f, a)
         foot = joints[k, joint_index(f"{side}_ankle")]
-        moved = np.linalg.norm((foot - joints[a, joint_index(f"{side}_ankle")])[:2])
-        if moved < 0.05 and labels.supporting[a, f]:
+        moved = np.linalg.norm((foot - joints[af, joint_index(f"{side}_ankle")])[:2])
+        if moved < 0.05 and labels.supporting[af, f]:
             # A foot that bore weight where it stands did not step.  One
             # that was off the floor (left behind by the other foot's step)
             # may land a step away from the weight where it lifted.
             continue
-        rel = foot - joints[a, joint_index(f"{side}_hip")]
+        if starts is not None and not _plausible_step(joints, f, af, k, height):
+            continue
+        rel = foot - joints[af, joint_index(f"{side}_hip")]
+        if offset is not None:
+            rel = rel - offset[f]
         rel[2] = 0.0
         dist = float(np.linalg.norm(rel))
         if dist > best_d:
             from ..body import body_frame
 
-            R = body_frame(joints[a : a + 1])[0]
+            R = body_frame(joints[af : af + 1])[0]
             best, best_d = R @ rel, dist
     if best is None:
         return "place"
