@@ -13,7 +13,7 @@ the mannequin, and captured twice:
 Printed (never asserted): per phrase and overall, the symbol agreement
 (direction + level per part per beat of the original), the median start-time
 error in beats, whether the truth capture is exact, the median limb-direction
-error of the fit, and frames per second of the whole video capture.
+error and MPJPE of the fit, and frames per second of the whole video capture.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ HOLDOUT = Path(__file__).resolve().parent / "holdout"
 
 def measure(path: Path, workdir: Path, view: str, effort: bool) -> dict:
     """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
+    from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
     from capture2notation.notation.formats import read
     from capture2notation.quantise.agreement import compare_scores
@@ -54,6 +55,9 @@ def measure(path: Path, workdir: Path, view: str, effort: bool) -> dict:
         "truth_exact": exact,
         "tempo": (float(score.tempo), float(video.score.tempo)),
         "limb_deg": _limb_error(np.asarray(truth.joints), np.asarray(video.motion.joints)),
+        # Not root-aligned: with the render's camera known, the fit's absolute
+        # position is part of what it gets right or wrong.
+        "mpjpe_cm": 100 * float(np.nanmean(mpjpe(np.asarray(truth.joints), np.asarray(video.motion.joints)))),
         "fps": truth.n_frames / seconds,
         "frames": truth.n_frames,
     }
@@ -73,7 +77,7 @@ def main() -> None:
             rows.append(r)
             print(f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
                   f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
-                  f"limb {r['limb_deg']:4.1f}°  {r['fps']:5.1f} fps", flush=True)
+                  f"limb {r['limb_deg']:4.1f}°  MPJPE {r['mpjpe_cm']:4.1f} cm  {r['fps']:5.1f} fps", flush=True)
     frames = sum(r["frames"] for r in rows)
     weights = np.array([r["frames"] for r in rows], float)
     print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames:")
@@ -81,6 +85,7 @@ def main() -> None:
     print(f"  median start error                    {np.nanmedian([r['start_error'] for r in rows]):.2f} beat")
     print(f"  truth captures exact                  {sum(r['truth_exact'] for r in rows)}/{len(rows)}")
     print(f"  median limb-direction error           {np.median([r['limb_deg'] for r in rows]):.1f}°")
+    print(f"  MPJPE (mean over phrases)             {np.mean([r['mpjpe_cm'] for r in rows]):.1f} cm")
     print(f"  whole capture speed (frame-weighted)  {np.average([r['fps'] for r in rows], weights=weights):.1f} fps")
 
 

@@ -14,14 +14,15 @@ exactly.  Guarantees (each is checked by ``tests/synthetic``):
   through the torso behind-low, no leg higher than the hip allows, no
   gesture leg down at place low where it would stand on the floor; the head
   within the neck's range of the chest, moving whenever the chest moves).
-  This is *verified*: the draw is interpreted at :data:`VERIFY_FPS` and
-  redrawn (same generator stream) until no
-  :class:`~synthetic.interpret.UnreachableWarning` is raised (end poses,
+  This is *verified*: the draw is interpreted at the caller's frame rate
+  (:data:`VERIFY_FPS` by default) and redrawn (same generator stream) until
+  no :class:`~synthetic.interpret.UnreachableWarning` is raised (end poses,
   paths within the extremes, holds, supports), so quantising the
   interpreted joints gives back exactly the symbols.  No arm symbol ends
   while the chest moves, and leg gestures never end while the weight
-  shifts, so the check holds at other frame rates too (property-tested at
-  10–50 fps).
+  shifts.  A foot's speed near the 0.2 m/s support threshold depends on the
+  frame rate, so verify at the rate the score will be performed at
+  (property-tested at 10–50 fps).
 
 Supports follow a dancer's logic: both feet (plié, middle, relevé), a
 weight transfer onto one foot followed by gestures of the free leg and a
@@ -322,6 +323,7 @@ def random_score(
     tempo=None,
     random_effort: bool = False,
     max_tries: int = 50,
+    fps: float = VERIFY_FPS,
 ) -> Score:
     """Draw a random valid, renderable score (see the module docstring).
 
@@ -342,6 +344,10 @@ def random_score(
         [0, 1]) into the header; otherwise the score has none (neutral).
     max_tries : int
         Redraws allowed before giving up.
+    fps : float
+        Frame rate at which the draw is verified: the one it will be
+        performed at (a foot's speed near DESIGN.md's 0.2 m/s support
+        threshold depends on the frame rate through finite differences).
 
     Returns
     -------
@@ -394,7 +400,7 @@ def random_score(
         score = Score(tuple(syms), title="random", tempo=bpm, meter=4, effort=effort)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", UnreachableWarning)
-            interpret(score, fps=VERIFY_FPS)
+            interpret(score, fps=fps)
         if not any(issubclass(w.category, UnreachableWarning) for w in caught):
             return score
     raise SyntheticError(f"no reachable random score in {max_tries} draws (n_beats={n_beats}, parts={parts})")

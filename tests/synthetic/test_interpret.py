@@ -146,7 +146,7 @@ def test_builtin_phrases_round_trip(name, fps):
     effort=st.booleans(),
 )
 def test_random_scores_round_trip(seed, fps, split, effort):
-    score = random_score(np.random.default_rng(seed), n_beats=8, split_arms=split, random_effort=effort)
+    score = random_score(np.random.default_rng(seed), n_beats=8, split_arms=split, random_effort=effort, fps=fps)
     assert_round_trip(score, fps)
 
 
