@@ -41,9 +41,13 @@ from capture2notation.io.atomic import atomic_path, write_text
 from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.labels import write_labels_csv
-from capture2notation.quantise.segment import SegmentParams, Segmentation, segment_motion
+from capture2notation.quantise.segment import (
+    Segmentation,
+    SegmentParams,
+    segment_motion,
+)
 
-__all__ = ["VIDEO_SUFFIXES", "MOTION_SUFFIXES", "CaptureResult", "input_kind", "capture", "load_motion"]
+__all__ = ["VIDEO_SUFFIXES", "MOTION_SUFFIXES", "CaptureResult", "input_kind", "capture", "load_motion", "tempo_note"]
 
 log = logging.getLogger(__name__)
 
@@ -239,7 +243,7 @@ def capture(
     seg = segment_motion(joints, fps, tempo=tempo, meter=meter, params=params, title=title)
     seconds["quantise"] = time.perf_counter() - t0
     if seg.tempo_estimated:
-        log.info("capture: estimated tempo %s bpm", seg.tempo)
+        log.info("capture: estimated tempo %s bpm%s", seg.tempo, tempo_note(seg))
     files, skipped = _write_outputs(outdir, seg, motion, track, input_path, kind, overlay)
     if effort:
         t0 = time.perf_counter()
@@ -324,6 +328,18 @@ def _interval(d: dict) -> str:
     return f"{d['median']:.2f} [{lo:.2f}, {hi:.2f}]"
 
 
+def tempo_note(seg) -> str:
+    """Text after an estimated tempo, e.g. ``" (estimated, 80% sure; else 36 bpm; give --tempo to fix it)"``.
+
+    A tempo estimated from movement alone may be half or double the one
+    the dancers counted; the page and the command line say so.
+    """
+    conf = seg.tempo_confidence
+    sure = f", {conf:.0%} sure" if np.isfinite(conf) else ""
+    other = f"; else {seg.tempo_runner_up} bpm" if seg.tempo_runner_up is not None else ""
+    return f" (estimated{sure}{other}; give --tempo to fix it)"
+
+
 def _effort_html(files: dict) -> str:
     """The Effort section of the index page: pooled estimate, emotion, plots."""
     if "effort.json" not in files:
@@ -365,7 +381,7 @@ def index_html(result: CaptureResult) -> str:
         else "<p>No video: the input was a motion file.</p>"
     )
     links = " · ".join(f'<a href="{html.escape(n)}">{html.escape(n)}</a>' for n in sorted(result.files) if n != "index.html")
-    tempo = f"{score.tempo} bpm" + (" (estimated)" if result.segmentation.tempo_estimated else "")
+    tempo = f"{score.tempo} bpm" + (tempo_note(result.segmentation) if result.segmentation.tempo_estimated else "")
     skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
     effort = _effort_html(result.files)

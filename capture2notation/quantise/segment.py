@@ -74,7 +74,7 @@ from .measured import upright_trunk
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .spans import _ZERO_SPEED, movement_spans
 from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
-from .tempo import estimate_tempo, snap
+from .tempo import estimate_tempo_detail, snap
 from .timing import progress_signal, refine_times
 
 __all__ = ["SegmentParams", "Movement", "Segmentation", "movement_spans", "segment", "segment_motion"]
@@ -150,6 +150,11 @@ class Segmentation:
     tempo : Fraction
     tempo_estimated : bool
     labels : FrameLabels
+    tempo_runner_up : Fraction or None
+        When estimated: the best other reading (usually half or double).
+    tempo_confidence : float
+        When estimated: probability that the tempo is within 15 % of
+        `tempo`; NaN when the tempo was given.
     """
 
     score: Score
@@ -158,6 +163,8 @@ class Segmentation:
     tempo: Fraction
     tempo_estimated: bool
     labels: FrameLabels = field(repr=False)
+    tempo_runner_up: Fraction | None = None
+    tempo_confidence: float = float("nan")
 
 
 # Gesture channels: part, segment label columns (upper, lower) or single.
@@ -327,7 +334,7 @@ def segment_motion(
         flat = flat_foot_pitch(smoothed, contact) if measured else None
         labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat))
     estimated = tempo is None
-    moves = None
+    moves, detail = None, None
     if estimated:
         moves = _gesture_movements(labels, joints, fps, params, measured=measured) + support_movements(
             labels, joints, fps, params, movement_spans, measured=measured
@@ -352,8 +359,9 @@ def segment_motion(
             # Clean key times are within half a frame of their grid time;
             # measured ones (fitted logistic, noisy) within a frame or two.
             tol = (0.3 if clean else 2.0) / fps
-            tempo = estimate_tempo(times, params.grid, tolerance_s=tol, durations=gestures or None, groups=groups,
-                                   max_offset_s=0.0 if clean else 3.0 / fps)
+            detail = estimate_tempo_detail(times, params.grid, tolerance_s=tol, durations=gestures or None,
+                                           groups=groups, max_offset_s=0.0 if clean else 3.0 / fps)
+            tempo = detail.tempo
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
     if tempo <= 0:
         raise QuantiseError(f"tempo must be > 0 beats per minute, got {tempo}")
@@ -371,7 +379,10 @@ def segment_motion(
     symbols = _symbols(merged, tempo, params.grid)
     key_frames = np.unique(np.r_[0, [min(m.end_frame, T - 1) for m in moves]].astype(int))
     score = Score(symbols=tuple(symbols), title=title, tempo=tempo, meter=meter)
-    return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels)
+    if detail is None:
+        return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels)
+    return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels,
+                        tempo_runner_up=detail.runner_up, tempo_confidence=detail.confidence)
 
 
 def segment(joints: np.ndarray, fps: float, tempo=None, meter: int = 4, params: SegmentParams | None = None, floor: float = 0.0) -> Score:

@@ -100,7 +100,7 @@ def estimate_tempo_detail(
     durations=None,
     groups=None,
     max_offset_s: float = 0.0,
-) -> Fraction:
+) -> TempoEstimate:
     """Estimate the tempo from the times at which movements start and arrive.
 
     A generative model of the key times scores each candidate tempo: a

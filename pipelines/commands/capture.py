@@ -29,6 +29,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
     from capture2notation.errors import PipelineError
     from capture2notation.quantise.segment import SegmentParams
     from pipelines.capture import capture as run
+    from pipelines.capture import tempo_note
 
     try:
         step = Fraction(grid)
@@ -39,9 +40,9 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
     tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
     result = run(input_path, outdir, backend=backend, tempo=tempo_value, fps_override=fps_override, progress=True,
                  params=SegmentParams(grid=step), effort=not no_effort, seed=seed, flip_test=flip_test)
-    how = "estimated" if result.segmentation.tempo_estimated else "given"
+    how = tempo_note(result.segmentation) if result.segmentation.tempo_estimated else " (given)"
     click.echo(f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
-               f"({result.kind}), tempo {result.score.tempo} bpm ({how})")
+               f"({result.kind}), tempo {result.score.tempo} bpm{how}")
     for note in result.skipped:
         click.echo(f"  not written: {note}")
     click.echo(f"  open {result.outdir / 'index.html'}")

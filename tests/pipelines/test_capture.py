@@ -85,6 +85,9 @@ def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
 def test_estimated_tempo_and_fps_override(sidecar, tmp_path):
     res = capture(sidecar, tmp_path / "o", progress=False, effort=False)
     assert res.segmentation.tempo_estimated and res.score.tempo == TEMPO
+    assert 0.5 < res.segmentation.tempo_confidence <= 1.0
+    page = (tmp_path / "o" / "index.html").read_text()
+    assert f"{TEMPO} bpm (estimated, " in page and "give --tempo to fix it" in page
     # Played twice as fast, the same frames are twice the tempo.
     res2 = capture(sidecar, tmp_path / "o2", fps_override=50.0, tempo=2 * TEMPO, progress=False, effort=False)
     assert score_differences(EXPECTED, res2.score.replace(tempo=TEMPO)) == []
