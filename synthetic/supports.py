@@ -302,7 +302,7 @@ class Support:
                 self.released[foot][f1 + 1 : stop + 1] = True
                 self.floor[foot][f1 + 1 : stop + 1] = False
 
-    def ik(self, foot: str, ankle_pos=None, foot_R=None, frames=slice(None)):
+    def ik(self, foot: str, ankle_pos=None, foot_R=None, frames=slice(None), toe_min=None):
         """Leg pose putting the ankle at `ankle_pos` with the foot turned to `foot_R`.
 
         Parameters
@@ -315,6 +315,8 @@ class Support:
             World foot orientations; default flat or in relevé as planned.
         frames : slice or index array
             Frames concerned (the hip follows the root there).
+        toe_min : (n,) ndarray, optional
+            Least toe height, metres; default the toe's standing height.
 
         Returns
         -------
@@ -341,7 +343,7 @@ class Support:
             ankle = np.clip(euler_near(shin.transpose(0, 2, 1) @ foot_R, 0.0, lim), lim[:, 0], lim[:, 1])
             # Past the ankle's extremes (a plié with the feet far apart) the
             # foot cannot stay flat: the heel lifts so the toe stays on the floor.
-            deficit = self.toe0 - (ankle_pos + (shin @ euler_to_matrix(ankle)) @ toe)[:, 2]
+            deficit = (self.toe0 if toe_min is None else toe_min) - (ankle_pos + (shin @ euler_to_matrix(ankle)) @ toe)[:, 2]
             if not np.any(deficit > 1e-6):
                 break
             ankle_pos[:, 2] += np.maximum(deficit, 0.0)
@@ -370,29 +372,7 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
             ankle_g[f1 + 1 : stop] = 0.0
         own = [(x, frame(x.start), frame(x.end)) for x in symbols if x.part in (limb.whole, limb.upper, limb.lower)]
         Qg, bg = _within_extremes(limb, Qg, bg, own, eff, sup.body)
-        # Landing: the ankle travels from where the gesture left it to its
-        # floor target while the foot turns flat (faster, so the toe does
-        # not catch the floor); the leg follows by IK.
-        idx = np.flatnonzero(landing)
         hip = sup.root + sup.hip_off[foot]
-        for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []:
-            g = run[0] - 1
-            w = progress(np.arange(1, run.size + 1) / run.size, eff.time, eff.weight)
-            shin_g = Qg[g] @ rot_x(limb.middle_angle(bg[g]))
-            a_g = hip[g] + Qg[g] @ sup.body.offsets[limb.joints[1]] + shin_g @ sup.body.offsets[limb.joints[2]]
-            F_g = shin_g @ euler_to_matrix(ankle_g[g])
-            target = sup.ankle[foot][run]
-            wo = np.minimum(1.0, 1.5 * w)
-            F = slerp_frames(F_g, rot_x(sup.pitch[foot][run[-1]]), wo * wo * (3.0 - 2.0 * wo))
-            # About the hip, not along a straight line: the leg keeps its
-            # length as it comes down and folds only near the floor, so a
-            # high leg does not bend its knee (which would lift the thigh
-            # past the hip's extreme).
-            u_g = a_g - hip[g]
-            v_t = target - hip[run]
-            r = np.linalg.norm(u_g) + w**3 * (np.linalg.norm(v_t, axis=-1) - np.linalg.norm(u_g))
-            u = (1.0 - w)[:, None] * u_g / np.linalg.norm(u_g) + w[:, None] * unit(v_t)
-            Q[run], beta[run], ankle[run] = sup.ik(foot, hip[run] + r[:, None] * unit(u), F, run)
         gest = ~floor
         Q[gest], beta[gest], ankle[gest] = Qg[gest], bg[gest], ankle_g[gest]
         free = gest
@@ -401,12 +381,16 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
         # toe above the floor too (a pitched foot reaches lower than its
         # ankle), by bending the knee.  A foot leaving the floor for a
         # gesture lifts off at once (:data:`LIFT_OFF_CLEARANCE`), so the
-        # gesture visibly begins at its start.
+        # gesture visibly begins at its start.  Once off the floor, a leg
+        # hanging near the floor (place low beside the supporting foot)
+        # flexes its foot instead (:func:`_flex_clear`): a straight leg
+        # lifted by a bent knee would read as bent (DESIGN.md bend ≥ 1).
         clear = _lift_off(floor, sup.toe0, sup.fps)
-        floor_z = sup.ankle0 - sup.toe0 + clear
+        floor_z = _ankle_floor(clear, sup.ankle0 - sup.toe0, sup.fps)
         Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
         ja = limb.joints[2]
         lim = sup.body.limits[ja]
+        steady = free & (clear >= LIFT_OFF_CLEARANCE)
         for _ in range(20):
             deficit = clear - _toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
             low = free & (deficit > 1e-6)
@@ -419,8 +403,42 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
             shin = Qf[low] @ rot_x(limb.middle_angle(bf[low]))
             flat = np.clip(euler_near(shin.transpose(0, 2, 1), 0.0, lim), lim[:, 0], lim[:, 1])
             ankle[low, 0] = np.maximum(ankle[low, 0], flat[:, 0])
+            flex = low & steady
+            if np.any(flex):
+                ankle[flex] = _flex_clear(sup.body, foot, limb, Qf[flex], bf[flex], ankle[flex], hip[flex],
+                                          clear[flex], lim)
+                deficit = clear - _toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
+                low = free & (deficit > 1e-6)
+                if not np.any(low):
+                    break
             floor_z[low] += np.where(clear[low] > 0, 1.0, 2.0) * deficit[low] + 1e-4
             Qf, bf = _keep_above_floor(limb, Q, beta, hip, floor_z, free)
+        # Landing: the ankle travels from where the gesture left it (clear
+        # of the floor) to its floor target while the foot turns flat
+        # (faster, so the toe does not catch the floor); the leg follows by
+        # IK, the toe kept up until it comes down at
+        # :data:`FOOT_CONTACT_SPEED` onto the end frame: a foot that
+        # touched down earlier would read as landing there.
+        idx = np.flatnonzero(landing)
+        for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []:
+            g = run[0] - 1
+            w = progress(np.arange(1, run.size + 1) / run.size, eff.time, eff.weight)
+            shin_g = Qf[g] @ rot_x(limb.middle_angle(bf[g]))
+            a_g = hip[g] + Qf[g] @ sup.body.offsets[limb.joints[1]] + shin_g @ sup.body.offsets[limb.joints[2]]
+            F_g = shin_g @ euler_to_matrix(ankle[g])
+            target = sup.ankle[foot][run]
+            wo = np.minimum(1.0, 1.5 * w)
+            F = slerp_frames(F_g, rot_x(sup.pitch[foot][run[-1]]), wo * wo * (3.0 - 2.0 * wo))
+            # About the hip, not along a straight line: the leg keeps its
+            # length as it comes down and folds only near the floor, so a
+            # high leg does not bend its knee (which would lift the thigh
+            # past the hip's extreme).
+            u_g = a_g - hip[g]
+            v_t = target - hip[run]
+            r = np.linalg.norm(u_g) + w**3 * (np.linalg.norm(v_t, axis=-1) - np.linalg.norm(u_g))
+            u = (1.0 - w)[:, None] * u_g / np.linalg.norm(u_g) + w[:, None] * unit(v_t)
+            toe_min = np.minimum(LIFT_OFF_CLEARANCE, sup.toe0 + FOOT_CONTACT_SPEED * (run[-1] - run) / sup.fps)
+            Qf[run], bf[run], ankle[run] = sup.ik(foot, hip[run] + r[:, None] * unit(u), F, run, toe_min)
         out[f"{foot}_leg"] = (Qf, bf, ankle)
     return out
 
@@ -442,6 +460,66 @@ def _lift_off(floor, toe0: float, fps: float) -> np.ndarray:
         f1 = int(ends[np.searchsorted(ends, f0 + 1)])
         k = np.arange(f0 + 1, f1)
         out[k] = np.minimum(toe0 + LIFT_OFF_SPEED * (k - f0) / fps, LIFT_OFF_CLEARANCE)
+    return out
+
+
+def _ankle_floor(clear, sole: float, fps: float) -> np.ndarray:
+    """(T,) least height of a free foot's ankle, metres.
+
+    While a foot lifts off (`clear` rising to :data:`LIFT_OFF_CLEARANCE`)
+    the whole foot rises: the ankle stays a sole's thickness `sole` above
+    the toe's clearance, so the foot reads as moving (DESIGN.md's support
+    speed) from the gesture's first frame.  Afterwards the ankle may come
+    down, at :data:`LIFT_OFF_SPEED` so the knee straightens smoothly, to the
+    clearance itself, the toe kept up by flexing the foot
+    (:func:`_flex_clear`).
+    """
+    T = len(clear)
+    out = sole + np.asarray(clear, float)
+    steady = clear >= LIFT_OFF_CLEARANCE
+    since = 0
+    for k in range(T):
+        since = since + 1 if steady[k] else 0
+        if since:
+            out[k] = max(LIFT_OFF_CLEARANCE, sole + LIFT_OFF_CLEARANCE - LIFT_OFF_SPEED * since / fps)
+    return out
+
+
+def _flex_clear(body: Body, foot: str, limb: Limb, Q, beta, ankle, hip, clear, lim):
+    """Ankle angles of free feet flexed (toe up) just enough to lift the toe to `clear`.
+
+    Parameters
+    ----------
+    Q : (n, 3, 3) ndarray
+        Thigh frames.
+    beta : (n,) ndarray
+        Knee bends, radians.
+    ankle : (n, 3) ndarray
+        Ankle Euler angles; the flexion (rx) only grows.
+    hip : (n, 3) ndarray
+    clear : (n,) ndarray
+        Least toe height, metres.
+    lim : (3, 2) ndarray
+        The ankle's extremes.
+
+    Returns
+    -------
+    (n, 3) ndarray
+        The ankle angles, flexed at most to the extreme (the knee makes up
+        the rest).
+    """
+    out = ankle.copy()
+    todo = np.ones(len(out), bool)
+    for rx in np.arange(0.0, lim[0, 1] + 1e-9, np.radians(0.25)):
+        cand = out[todo].copy()
+        cand[:, 0] = np.maximum(cand[:, 0], rx)
+        ok = _toe(body, foot, limb, Q[todo], beta[todo], cand, hip[todo])[:, 2] >= clear[todo] + 1e-4
+        idx = np.flatnonzero(todo)
+        out[idx[ok]] = cand[ok]
+        todo[idx[ok]] = False
+        if not todo.any():
+            break
+    out[todo, 0] = np.maximum(out[todo, 0], lim[0, 1])
     return out
 
 

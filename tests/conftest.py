@@ -6,6 +6,13 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# CI (``HYPOTHESIS_PROFILE=ci`` in .ci/run) tries a fixed set of examples, so
+# that a clean checkout gives the same result every run; locally Hypothesis
+# explores new examples and keeps any failure in .hypothesis/ for replay.
+settings.register_profile("ci", derandomize=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 _DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "fixtures"
 

@@ -8,12 +8,14 @@ and duration snapped to the beat grid (tempo given, or :func:`estimate_tempo`).
 
 Two regimes, chosen from the measured jitter:
 
-Clean motion (the virtual dancer's truth; jitter ≤ 0.05°/frame)
+Clean motion (the virtual dancer's truth: exact holds, directions jittering ≤ 0.05°/frame)
     Not smoothed.  A hold is exactly still, so any motion belongs to a
     movement, and back-to-back movements part only where the part is exactly
     (0.05°) on a written pose — a canonical direction and a bend of 30°
     steps — at a frame of the beat grid, having moved ≥ 5° since the last
-    boundary.  Speed minima alone are not trusted: a limb turning about a
+    boundary (a limb's two segments on written directions, the whole limb
+    on none, only at a speed minimum: a whole-limb movement can pass
+    through such a pose).  Speed minima alone are not trusted: a limb turning about a
     fixed axis slows down mid-way, and the Space modulation makes the reach
     dip and recover.  This recovers the written symbols exactly whenever the
     dancer reaches its written poses.
@@ -454,9 +456,17 @@ def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = No
         bend_ok = np.abs(bend - 30.0 * np.round(bend / 30.0)) < tol
         up, low = (_off_canonical_series(labels.vectors[:, c]) for c in cols[1:])
         ok = ((whole < tol) & bend_ok) | ((up < tol) & (low < tol))
+        # Both segments on written directions with the whole limb on none:
+        # a whole-limb movement (great circle, bend changing with it) can
+        # pass exactly through such a pose mid-way, e.g. a leg unbending
+        # from forward middle bend 2 to place low has its thigh forward
+        # middle and shin forward low a quarter of the way; only a movement
+        # that slows there arrives (see :func:`~.spans.movement_spans`).
+        pair_only = ok & ~((whole < tol) & bend_ok)
     else:
         bend = None
         ok = _off_canonical_series(labels.vectors[:, cols[0]]) < tol
+        pair_only = np.zeros_like(ok)
     if on_grid is not None:
         ok = ok & on_grid
 
@@ -473,6 +483,7 @@ def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = No
         return change >= min_change
 
     key.on_grid = on_grid is not None
+    key.needs_minimum = lambda f: bool(pair_only[f] and not forced[f])
     return key
 
 
@@ -603,7 +614,11 @@ def _gesture_movements(
         whole = labels.index(part)
         u_list, reach, bend_list = _channel(labels, joints, part)
         noise = max([_noise_deg(u) for u in u_list] + [_scalar_noise(x) for x in bend_list])
-        clean = params.smooth_s is None and not measured and noise <= _CLEAN_NOISE_DEG
+        # Truth-like motion (exact holds) is clean when its directions are:
+        # a knee or elbow that bends and straightens within every movement
+        # (Space, the floor) at a low frame rate leaves the bend a local
+        # cubic's residual of a fraction of a degree, jitter or not.
+        clean = params.smooth_s is None and not measured and max(_noise_deg(u) for u in u_list) <= _CLEAN_NOISE_DEG
         # Clean motion: the smooth reach, split at written poses only; noisy
         # motion: the bend itself (smoothed), split at deep speed minima.
         x_list = reach if clean else bend_list

@@ -89,15 +89,23 @@ def movement_spans(
 def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> list[tuple[int, int]]:
     """Split [a, b] where the motion passes a written pose.
 
-    With a beat grid every grid frame accepted by ``key_pose`` is a boundary;
-    without, only such frames next to a local speed minimum (a minimum in
-    interval m puts the boundary at frame m, the next movement's first
-    interval, or m + 1, this movement's last).
+    With a beat grid every grid frame accepted by ``key_pose`` is a boundary
+    (those for which ``key_pose.needs_minimum(f)``, if given, is true only
+    next to a local speed minimum: poses a movement may pass through
+    mid-way); without, only such frames next to a local speed minimum (a
+    minimum in interval m puts the boundary at frame m, the next movement's
+    first interval, or m + 1, this movement's last).
     """
     cuts = []
+    needs_minimum = getattr(key_pose, "needs_minimum", None)
+
+    def slows(f: int) -> bool:
+        # A local speed minimum in the interval just before or after f.
+        return any(0 < m < s.size - 1 and s[m] <= s[m - 1] and s[m] <= s[m + 1] for m in (f - 1, f))
+
     if key_pose.on_grid:
         for f in range(a + 1, b + 1):
-            if key_pose(f, cuts[-1] if cuts else a):
+            if key_pose(f, cuts[-1] if cuts else a) and (needs_minimum is None or not needs_minimum(f) or slows(f)):
                 cuts.append(f)
     else:
         for m in range(a + 1, b):

@@ -196,3 +196,69 @@ def test_random_scores_with_supports_round_trip_their_support_column():
         exact += got == want
     assert count >= 6  # the draws do exercise supports
     assert exact == n
+
+
+# Barre exercises: the weight onto one foot (held 1-4 beats), one-beat
+# gestures of the free leg ("side" = the free leg's own side), a close.
+# Before the fixes a free leg at ``place low`` beside the supporting foot
+# bent its knee to clear the floor (unreachable, read ``bend=2``), the close
+# that followed touched down mid-way (``support`` read half a beat early),
+# at 12.5 fps a leg unbending from ``forward middle bend=2`` to ``place
+# low`` was split where its thigh and shin passed written directions, and a
+# knee bent by Space mid-gesture made the leg read as noisy motion.
+_BARRE = {
+    "b01": (72, "right", 1, "", ("forward low", "side low", "back low", "side middle", "side low",
+                                 "forward middle bend=2", "place low")),
+    "b02": (96, "left", 2, "", ("forward low", "side low", "back low", "side middle", "side low",
+                                "forward middle bend=2", "place low")),
+    "b03": (56, "right", 1, "", ("side low", "forward low", "side middle", "back low", "forward middle bend=2",
+                                 "side low")),
+    "b04": (120, "left", 2, "", ("side low", "back low", "forward middle bend=2", "side middle", "forward low",
+                                 "side low")),
+    "b05": (64, "right", 1, "", ("forward low", "forward middle bend=2")),
+    "b06": (88, "left", 2, "", ("back low", "side middle", "place low")),
+    "b07": (80, "right", 1, "", ("side low", "back low", "forward low", "side low")),
+    "b08": (108, "left", 2, "", ("forward middle bend=2", "side low", "back low", "place low")),
+    "b09": (60, "right", 1, "", ("back low", "side low", "forward low", "forward middle bend=2", "place low",
+                                 "side middle")),
+    "b10": (100, "left", 2, "", ("side middle", "forward low", "back low", "side low", "forward middle bend=2")),
+    "b11": (84, "right", 4, "emotion: happy", ("side low", "place low", "forward low", "forward middle bend=2",
+                                               "side middle", "place low")),
+    "b12": (112, "left", 2, "effort: time=-3.5 weight=0.41 space=1", ("place low", "back low", "side low",
+                                                                     "forward middle bend=2", "side low")),
+    # Indirect Space and light Effort: the knee bends and straightens within
+    # every gesture, which at 12.5 fps once made the leg's motion look noisy.
+    "b13": (113, "right", 1, "effort: time=-2.2 weight=0.7 space=0.5", ("side middle", "place low", "forward low",
+                                                                        "place low")),
+    "b14": (96, "left", 1, "emotion: happy", ("place low", "back low", "place low", "side low", "place low")),
+}
+
+
+def _barre_score(name):
+    from capture2notation.notation.formats.lab import loads
+
+    tempo, support, hold, effort, gestures = _BARRE[name]
+    free = "left" if support == "right" else "right"
+    lines = [f"title: barre {name}", f"tempo: {tempo}", "meter: 4", effort,
+             "0 1 support place middle", f"1 {hold} {support}_support place middle"]
+    t = 1 + hold
+    for g in gestures:
+        lines.append(f"{t} 1 {free}_leg {g.replace('side', free)}")
+        t += 1
+    lines.append(f"{t} 1 support place middle")
+    return loads("\n".join(line for line in lines if line) + "\n")
+
+
+@pytest.mark.parametrize("fps", [25.0, 12.5, 30.0])
+@pytest.mark.parametrize("name", sorted(_BARRE))
+def test_barre_exercise_round_trips_exactly(name, fps):
+    """Truth joints of a barre exercise quantise back to its score, and the dancer reaches every symbol."""
+    from capture2notation.quantise.agreement import score_differences
+    from synthetic.interpret import interpret
+    from synthetic.reach import UnreachableWarning
+
+    score = _barre_score(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnreachableWarning)
+        joints = interpret(score, fps=fps).joints()
+    assert score_differences(score, segment_motion(joints, fps, tempo=score.tempo).score) == []

@@ -106,7 +106,10 @@ def assert_round_trip(score, fps):
                 labels[sym.part] = _labels(J, sym.part)
             assert labels[sym.part][f1] == (sym.direction, sym.level, sym.bend), (sym, f1)
             v = segment_vectors(J, *PART_SEGMENTS[sym.part])
-            if f1 - f0 >= 2 and not np.allclose(v[f0], v[f1], atol=1e-3):
+            # A held arm may drift up to ~1° while the chest turns it against
+            # the shoulder's extreme, and recover when its next symbol starts;
+            # only a movement larger than that must still be moving.
+            if f1 - f0 >= 2 and not np.allclose(v[f0], v[f1], atol=0.02):
                 assert not np.allclose(v[f1 - 1], v[f1], atol=1e-6), (sym, "arrived early")
             continue
         for foot in FEET[sym.part]:

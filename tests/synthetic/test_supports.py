@@ -102,3 +102,54 @@ def test_a_heel_lowered_slowly_steps_at_once_at_low_frame_rates():
     sup = _contact(m.joints(), fps, "right")
     (f0, f1), = [(a, b) for x, a, b in m.events if x.part == "right_support" and x.direction == "right"]
     assert f1 - f0 == 3 and sup[f0] and not sup[f1 - 2] and sup[f1]
+
+
+def _barre(support="right", hold=1, gestures=("left low", "place low"), tempo=72):
+    """Weight onto one foot, one-beat free-leg gestures, a close, then a hold (an arm moves on)."""
+    free = "left" if support == "right" else "right"
+    syms = [Symbol(F(0), F(1), "support", "place", "middle"), Symbol(F(1), F(hold), f"{support}_support", "place", "middle")]
+    t = 1 + hold
+    for g in gestures:
+        d, lv, *bend = g.replace("side", free).split()
+        syms.append(Symbol(F(t), F(1), f"{free}_leg", d, lv, int(bend[0].split("=")[1]) if bend else 0))
+        t += 1
+    syms.append(Symbol(F(t), F(1), "support", "place", "middle"))
+    syms.append(Symbol(F(t + 2), F(1), "right_arm", "forward", "middle"))
+    return Score(tuple(syms), title="barre", tempo=F(tempo), meter=4), free
+
+
+@pytest.mark.parametrize("fps", [12.5, 25.0, 30.0])
+@pytest.mark.parametrize("before", ["back low", "forward middle bend=2", "side middle"])
+def test_a_free_leg_at_place_low_hangs_straight_just_above_the_floor(fps, before):
+    """Standing on one foot, a free leg brought to place low (bend 0) hangs
+    straight with its foot just clear of the floor: not a support, not bent,
+    not unreachable (the foot flexes instead of the knee bending)."""
+    import warnings
+
+    from capture2notation.notation.directions import bend_angle
+    from synthetic.reach import UnreachableWarning
+
+    score, free = _barre(gestures=(before, "place low"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnreachableWarning)
+        m = interpret(score, fps=fps)
+    J = m.joints()
+    f1 = [e for s, _, e in m.events if s.part == f"{free}_leg"][-1]
+    ankle, toe = J[f1, joint_index(f"{free}_ankle")], J[f1, joint_index(f"{free}_toe")]
+    assert 0.03 < min(ankle[2], toe[2]) < 0.06
+    knee = bend_angle(J[f1, joint_index(f"{free}_hip")], J[f1, joint_index(f"{free}_knee")], ankle)
+    assert knee < 5.0
+    assert not _contact(J, fps, free)[f1]
+
+
+@pytest.mark.parametrize("fps", [12.5, 25.0, 30.0])
+@pytest.mark.parametrize("last", ["place low", "side low", "forward middle bend=2"])
+def test_a_closing_foot_lands_on_the_close_end_frame(fps, last):
+    """The free foot closes beside the supporting one: it touches the floor
+    (reads as supporting) first on the close's end frame, not before."""
+    score, free = _barre(support="left", gestures=("forward low", last), tempo=96)
+    m = interpret(score, fps=fps)
+    J = m.joints()
+    f0, f1 = [(a, b) for s, a, b in m.events if s.part == "support"][-1]
+    c = _contact(J, fps, free)
+    assert c[f1] and not c[f0 : f1].any()
