@@ -25,10 +25,12 @@ programming (Viterbi):
   twice the depth, which needs strong evidence.
 
 Where the chosen candidates are clearly apart, their side sets the sign of
-the depth of the world landmarks' upper arm and forearm (the magnitude stays
-the landmarks': against a model length, foreshortening overstates the depth
-of segments near the image plane), so that the starting pose and the
-direction prior of the fit agree with the choice.
+the depth of the world landmarks' upper arm and forearm, so that the
+starting pose and the direction prior of the fit agree with the choice.  The
+magnitude stays the landmarks' only within the band the segment's image
+length allows (:mod:`~capture2notation.fitting.foreshorten`): near the
+image plane that band is wide (foreshortening against a model length is a
+poor measure there), far from it the image length decides.
 
 Measured through BlazePose on the built-in phrases and random scores 0–3
 (mannequin, 25 fps, 640×480): per-frame gesture label agreement front 75.8 →
@@ -45,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .camera import Camera
+from .foreshorten import EPS, bound_depth
 from .ik import _swing
 from .model import PoseModel
 
@@ -78,10 +81,11 @@ class DepthOptions:
         A segment's chosen side overrides the world landmarks' only where its
         two candidates' depth differs by more than this fraction of its
         length (elsewhere the side hardly matters and is noise).
-    foreshortened : float
-        Where the chosen candidate's depth exceeds this fraction of the
-        segment's length (image length under 0.71 of it for the default), the
-        world landmarks' depth is raised to at least the candidate's.
+    band : float or None
+        Relative uncertainty of a segment's image length over its length:
+        the world landmarks' out-of-plane fraction is brought into the band
+        that image length allows (:func:`~capture2notation.fitting.foreshorten.bound_depth`);
+        None keeps it.
     elbow : float
         Cost of a forearm bent fully towards the upper arm's back.
     elbow_slack : float
@@ -94,7 +98,7 @@ class DepthOptions:
     sigma_step: float = 0.06
     back_high: float = 8.0
     apart: float = 0.3
-    foreshortened: float = 0.7
+    band: float | None = EPS
     elbow: float = 6.0
     elbow_slack: float = 0.3
 
@@ -297,16 +301,18 @@ def choose_arm_depths(model: PoseModel, cam: Camera, params: np.ndarray, names, 
         # model length overstates the depth of segments near the image plane).
         d_up = tw[:, i_e] - tw[:, i_s]
         d_fore = tw[:, i_w] - tw[:, i_e]
-        for d, c, L in ((d_up, e_c - S, upper), (d_fore, w_c - e_c, fore)):
+        # Image length over model length of each segment, at its start's depth.
+        r_up = np.where(seen & shown, np.linalg.norm(e_px - s_px, axis=1) * S[:, 2] / (cam.focal * upper), np.nan)
+        r_fore = np.where(seen, np.linalg.norm(w_px - e_px, axis=1) * e_c[:, 2] / (cam.focal * fore), np.nan)
+        for d, c, L, r in ((d_up, e_c - S, upper, r_up), (d_fore, w_c - e_c, fore, r_fore)):
             apart = seen & (np.abs(c[:, 2]) > opt.apart * L) & np.isfinite(d[:, 2])
             flip = apart & (np.sign(d[:, 2]) != np.sign(c[:, 2]))
             d[flip, 2] = -d[flip, 2]
-            # A strongly foreshortened segment's depth is well measured by its
-            # image length: the world landmarks may not flatten it.
-            short = apart & (np.abs(c[:, 2]) > opt.foreshortened * L)
-            n = np.linalg.norm(d, axis=1)
-            dz = np.sign(c[:, 2]) * np.maximum(np.abs(d[:, 2]), np.abs(c[:, 2]) / L * n)
-            d[short, 2] = dz[short]
+            # How far the segment leaves the image plane is what its image
+            # length says, within that length's uncertainty: the world
+            # landmarks' amount is kept only inside that band.
+            if opt.band is not None:
+                d[:] = bound_depth(d, r, opt.band, side=np.sign(c[:, 2]))
         hand = tw[:, i_h] - tw[:, i_w]
         tw[:, i_e] = tw[:, i_s] + d_up
         tw[:, i_w] = tw[:, i_e] + d_fore

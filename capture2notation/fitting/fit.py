@@ -12,7 +12,10 @@ Data terms (see :mod:`capture2notation.fitting.solver` for the solver):
   BlazePose leans the trunk 20–40° towards the camera);
 * floor (known camera only): the lowest foot point stands at its standing
   height, z = 0 being the floor, which ties the figure's depth to where its
-  feet meet the floor in the image.
+  feet meet the floor in the image; the starting depth comes from there too
+  (:mod:`~capture2notation.fitting.floor`), since the figure's image size
+  misjudges it by 0.2–0.4 m through BlazePose and the arms' foreshortening
+  is judged at that depth.
 
 Priors: joint limits, a pull of the trunk to upright, and temporal
 smoothness — loose and Jacobi-coupled in the main solve, then firm and exact
@@ -31,6 +34,7 @@ from ..body import JOINTS, Body, joint_index
 from ..errors import FittingError
 from .camera import DEFAULT_HFOV_DEG, Camera
 from .depth import choose_arm_depths
+from .floor import FLOOR_POINTS, floor_depth, support_depth
 from .ik import initial_angles
 from .lengths import offsets_from_ratios
 from .model import PoseModel
@@ -251,7 +255,7 @@ def _direction_terms(names, tc, tw):
     return pairs, np.stack(dirs, 1), np.stack(w, 1)
 
 
-def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body) -> np.ndarray:
+def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body, floor: bool = False) -> np.ndarray:
     """Per-clip proportions from the image lengths of the segments.
 
     A segment's image length, turned into metres at its depth, is its true
@@ -265,7 +269,7 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body) -> np.ndarray:
     ankle sits above our ankle joint) while the size stays the body's.
     """
     model0 = PoseModel(body)
-    depth = camera.to_camera(_initial_params(model0, camera, names, tx, tc, None, pose=False)[:, :3])[:, 2]
+    depth = camera.to_camera(_initial_params(model0, camera, names, tx, tc, tw, pose=False, floor=floor)[:, :3])[:, 2]
     ratio = np.full(_J, np.nan)
     base = np.linalg.norm(body.offsets, axis=1)
     for j, name in enumerate(JOINTS):
@@ -287,11 +291,43 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body) -> np.ndarray:
     return offsets_from_ratios(ratio, body, relative=True)
 
 
-def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool = True) -> np.ndarray:
+def _floor_start_depth(model: PoseModel, cam: Camera, names, tx, tc, tw, size_depth, rest) -> np.ndarray:
+    """(T,) starting depth from the feet on the floor (:mod:`~capture2notation.fitting.floor`).
+
+    The lower foot (world targets `tw`, else the image) stands on the floor;
+    frames whose feet are not seen keep the image-size depth `size_depth`,
+    calibrated against the floor's.
+    """
+    idx = np.array([[model.index(n) for n in foot] for foot in FLOOR_POINTS])
+    cols = np.array([[names.index(n) for n in foot] for foot in FLOOR_POINTS])
+    lowest = model.body.rest[[joint_index("right_toe"), joint_index("right_ankle")], 2].min()
+    base = rest[idx, 2].min()
+    heights = (rest[idx, 2] - base + lowest).mean(axis=1)
+    shift = None
+    if tw is not None:
+        down = cam.R @ np.array([0.0, 0.0, -1.0])  # camera-aligned world targets
+        lowness = np.mean(tw[:, cols] @ down, axis=2)  # NaN unless both points are seen
+        # The body model stands its pelvis above the ankles, behind the
+        # foot's centre by this much along the foot.
+        ankles = np.array([model.index(f"{foot[0].split('_')[0]}_ankle") for foot in FLOOR_POINTS])
+        back = float(np.mean(rest[idx, 1].mean(axis=1) - rest[ankles, 1]))
+        along = (tw[:, cols[:, 1]] - tw[:, cols[:, 0]]) @ cam.R  # heel -> toe, world axes
+        along[..., 2] = 0.0
+        n = np.linalg.norm(along, axis=-1, keepdims=True)
+        shift = -back * np.where(n > 1e-6, along / np.maximum(n, 1e-6), np.nan)  # a foot seen end-on: no shift
+    else:
+        lowness = np.mean(tx[:, cols][..., 1], axis=2)
+    feet = floor_depth(cam, tx[:, cols], tc[:, cols], heights, float(lowest - base), shift)
+    return support_depth(feet, lowness, size_depth)
+
+
+def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool = True,
+                    floor: bool = False) -> np.ndarray:
     """Starting parameters of every frame.
 
-    The root is under the hip midpoint at a depth from the figure's image
-    scale; the pelvis faces as the hips say; with `pose`, the joint angles
+    The root is under the hip midpoint at a depth from the feet on the floor
+    when `floor` (a known camera), else from the figure's image scale; the
+    pelvis faces as the hips say; with `pose`, the joint angles
     come from :func:`~capture2notation.fitting.ik.initial_angles` on the
     world landmarks, or on the 2D landmarks lifted by :func:`_lift`.
     """
@@ -317,6 +353,8 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool
     seen = np.any(np.isfinite(est), axis=1)
     if seen.any():
         depth[seen] = np.nanquantile(est[seen], 0.3, axis=1)
+    if floor:
+        depth = _floor_start_depth(model, cam, names, tx, tc, tw, depth, rest)
     depth = fill(depth, fallback=float(np.linalg.norm(cam.centre)))
     centre = np.where(np.isfinite(pel_px), pel_px, neck_px)
     centre = fill2(centre, fallback=np.array(cam.K[:2, 2]))
@@ -513,10 +551,11 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
         if image_size is None:
             raise FittingError("fit_keypoints needs a camera or the image_size (width, height) for a default camera")
         camera = refine_focal(xy, conf, fps, Camera.default(image_size), world=world, body=body, options=opt)
-    model, terms, (names, tx, tc, tw), use2 = _problem(xy, conf, world, body, camera, opt)
-    if not set_floor and opt.sigma_floor > 0:
+    known = not set_floor
+    model, terms, (names, tx, tc, tw), use2 = _problem(xy, conf, world, body, camera, opt, floor=known)
+    if known and opt.sigma_floor > 0:
         _floor_terms(model, terms, tc, names)
-    params0 = _initial_params(model, camera, names, tx, tc, tw)
+    params0 = _initial_params(model, camera, names, tx, tc, tw, floor=known)
     if tw is not None:
         tw = _impute_shoulders(model, camera, params0, names, tc, tw)
         if opt.depth is not None:
@@ -525,7 +564,7 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
             # starts on.
             tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth)
         _, terms.dirs, terms.wd = _direction_terms(names, tc, tw)
-        params0 = _initial_params(model, camera, names, tx, tc, tw)
+        params0 = _initial_params(model, camera, names, tx, tc, tw, floor=known)
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
     params, cost = rewarm(model, params, cost, terms, fps, opt)
     for _ in range(opt.root_passes):
@@ -645,7 +684,7 @@ def _quick_cost(xy, conf, fps, cam, world, body, opt) -> float:
     return float(np.sum(cost))
 
 
-def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions):
+def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor: bool = False):
     """Model with the clip's segment lengths and the data terms of a 2D fit.
 
     Returns
@@ -657,7 +696,7 @@ def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions):
         Targets with a reprojection term.
     """
     names, tx, tc, tw = _targets_from_landmarks(xy, conf, world, opt)
-    offsets = _image_offsets(names, tx, tc, tw, camera, body)
+    offsets = _image_offsets(names, tx, tc, tw, camera, body, floor)
     model = PoseModel(body, offsets)
     w_targets = np.array([t[2] for t in TARGETS_2D])
     use2 = w_targets > 0
