@@ -8,7 +8,8 @@ code) is performed by the virtual dancer, rendered at 25 fps, 640×480, with
 the mannequin, and captured twice:
 
 * from the truth sidecar (no perception: the quantiser alone), and
-* from the video (BlazePose → 3D fit → quantiser), the tempo estimated.
+* from the video (BlazePose → 3D fit → quantiser), the tempo estimated
+  (or given, ``--tempo-given``).
 
 Printed (never asserted): per phrase and overall, the symbol agreement
 (direction + level per part per beat of the original), the median start-time
@@ -28,7 +29,8 @@ import numpy as np
 HOLDOUT = Path(__file__).resolve().parent / "holdout"
 
 
-def measure(path: Path, workdir: Path, view: str, effort: bool) -> dict:
+def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: bool = False,
+            flip_test: bool | None = None) -> dict:
     """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
     from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
@@ -44,7 +46,9 @@ def measure(path: Path, workdir: Path, view: str, effort: bool) -> dict:
     from_truth = capture(render / "truth.npz", workdir / "truth", tempo=score.tempo, progress=False, effort=False)
     exact = compare_scores(score, from_truth.score).exact
     t0 = time.perf_counter()
-    video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False)
+    video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False,
+                    tempo=score.tempo if tempo_given else None,
+                    **({} if flip_test is None else {"flip_test": flip_test}))
     seconds = time.perf_counter() - t0
     a = compare_scores(score, video.score)
     truth = read_truth(render / "truth.npz")
@@ -68,19 +72,23 @@ def main() -> None:
     ap.add_argument("--view", default="front", choices=("front", "45", "side"))
     ap.add_argument("--phrases", type=Path, default=HOLDOUT, help="folder of .lab phrases")
     ap.add_argument("--effort", action="store_true", help="include the Effort estimate in the timed capture")
+    ap.add_argument("--tempo-given", action="store_true", help="give the video capture the written tempo")
+    ap.add_argument("--flip-test", action=argparse.BooleanOptionalAction, default=None,
+                    help="BlazePose's mirrored second pass (default: capture's default)")
     args = ap.parse_args()
     paths = sorted(args.phrases.glob("*.lab"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for p in paths:
-            r = measure(p, Path(tmp) / p.stem, args.view, args.effort)
+            r = measure(p, Path(tmp) / p.stem, args.view, args.effort, args.tempo_given, args.flip_test)
             rows.append(r)
             print(f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
                   f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
                   f"limb {r['limb_deg']:4.1f}°  MPJPE {r['mpjpe_cm']:4.1f} cm  {r['fps']:5.1f} fps", flush=True)
     frames = sum(r["frames"] for r in rows)
     weights = np.array([r["frames"] for r in rows], float)
-    print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames:")
+    how = "given" if args.tempo_given else "estimated"
+    print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames, tempo {how}:")
     print(f"  symbol agreement (mean over phrases)  {np.mean([r['agreement'] for r in rows]):.1%}")
     print(f"  median start error                    {np.nanmedian([r['start_error'] for r in rows]):.2f} beat")
     print(f"  truth captures exact                  {sum(r['truth_exact'] for r in rows)}/{len(rows)}")
