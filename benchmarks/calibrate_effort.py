@@ -68,8 +68,12 @@ def _performance(seed: int, effort: Effort, tempo, n_moves: int = 3):
     return random_arm_score(rng, n_moves, tempo=tempo, part=part, effort=effort)
 
 
+#: Options of estimate_effort for every recovery run (set by main()).
+ESTIMATE_KW: dict = {}
+
+
 def _recovery_job(args):
-    seed, noise, capture_fn = args
+    seed, noise, capture_fn, est_kw = args
     rng = np.random.default_rng(seed)
     truth = Effort(time=float(rng.uniform(-4.5, -1.8)), weight=float(rng.uniform(0.3, 0.8)),
                    space=float(rng.choice([0.0, 0.5, 1.0])))
@@ -80,9 +84,11 @@ def _recovery_job(args):
             joints = joints + noise * rng.standard_normal(joints.shape)
         conf, fps, times = None, FPS, None
     else:
-        joints, conf, fps, times = capture_fn(score, FPS)
+        joints, conf, fps, times, captured = capture_fn(score, FPS)
+        if est_kw.get("windows") == "captured":
+            score = captured.replace(effort=score.effort)
     t0, c0 = time.perf_counter(), time.process_time()
-    res = estimate_effort(joints, conf, fps, score, rng=rng, times=times)
+    res = estimate_effort(joints, conf, fps, score, rng=rng, times=times, refine=est_kw.get("refine", True))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     rows = []
     for m in res.movements:
@@ -119,7 +125,7 @@ def _print_recovery(title, results):
 def recovery(n_perf: int, seed: int, noise: float, workers: int, capture_fn=None, title=None):
     """Run part 1 on `n_perf` performances; returns the per-performance results."""
     seeds = np.random.default_rng(seed).integers(0, 2**63 - 1, size=n_perf)
-    args = [(int(s), noise, capture_fn) for s in seeds]
+    args = [(int(s), noise, capture_fn, dict(ESTIMATE_KW)) for s in seeds]
     if workers > 1 and capture_fn is None:
         with concurrent.futures.ProcessPoolExecutor(workers) as ex:
             results = list(ex.map(_recovery_job, args))
@@ -135,8 +141,10 @@ def recovery_through_capture(capture_fn, n_perf: int = 30, seed: int = 1974):
     Parameters
     ----------
     capture_fn : callable
-        ``capture_fn(score, fps) -> (joints (T,J,3), confidence (T,J), fps, times (T,))``:
-        animate and render `score`, then recover 3D joints from the video.
+        ``capture_fn(score, fps) -> (joints (T,J,3), confidence (T,J), fps, times (T,), captured Score)``:
+        animate and render `score`, then recover 3D joints (and the quantised
+        score) from the video.  The movement windows come from the truth
+        score unless ``ESTIMATE_KW["windows"] == "captured"``.
     """
     return recovery(n_perf, seed, 0.0, 1, capture_fn=capture_fn, title="recovery through the capture path")
 
@@ -152,10 +160,13 @@ def blazepose_capture(score, fps=FPS, size=(640, 480), view="front"):
     -------
     joints (T, J, 3), confidence (T, J), fps, times (T,)
         From the capture's ``capture.npz``.
+    captured : Score
+        The capture's quantised ``score.lab``.
     """
     import tempfile
     from pathlib import Path
 
+    from capture2notation.notation import read
     from pipelines.capture import capture
     from synthetic.render.job import render_score
 
@@ -169,7 +180,7 @@ def blazepose_capture(score, fps=FPS, size=(640, 480), view="front"):
             if names != tuple(JOINTS):
                 raise RuntimeError(f"capture joints {names} differ from the canonical {tuple(JOINTS)}")
             return (np.asarray(z["joints"], float), np.asarray(z["confidence"], float), float(z["fps"]),
-                    np.asarray(z["times"], float))
+                    np.asarray(z["times"], float), read(tmp / "capture" / "score.lab"))
 
 
 # --- emotion -------------------------------------------------------------------
@@ -253,7 +264,11 @@ def main(argv=None):
     ap.add_argument("--skip-emotion", action="store_true")
     ap.add_argument("--blazepose", type=int, default=0, metavar="N",
                     help="Also part 1 through render -> BlazePose -> 3D fitting on N performances (slow).")
+    ap.add_argument("--windows", choices=("truth", "captured"), default="truth",
+                    help="Through BlazePose: movement windows from the truth score or the captured (quantised) one.")
+    ap.add_argument("--no-refine", action="store_true", help="Use the score's windows as given (no refinement).")
     a = ap.parse_args(argv)
+    ESTIMATE_KW.update(windows=a.windows, refine=not a.no_refine)
     n_perf, n_emo = (6, 6) if a.quick else (40, 30)
     print(f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs (synthetic.interpret missing)'}")
     if not a.skip_recovery:

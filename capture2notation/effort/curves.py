@@ -36,7 +36,22 @@ from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_MIDDLE_JOINT, PART_SEGMENTS
 
-__all__ = ["MIN_ANGLE_DEG", "MIN_FRAMES", "REACH_MARGIN", "SNAP_S", "ProgressCurve", "limb_reach", "progress_curve"]
+__all__ = [
+    "END_DROP",
+    "MAX_EXTEND",
+    "MIN_ANGLE_DEG",
+    "MIN_FRAMES",
+    "MIN_TURN_COS",
+    "MOVING_FRACTION",
+    "NOISE_SIGMAS",
+    "REACH_MARGIN",
+    "SNAP_S",
+    "START_FRACTION",
+    "ProgressCurve",
+    "limb_reach",
+    "progress_curve",
+    "refine_window",
+]
 
 #: A movement whose direction turns by less than this is "held" (no curve).
 MIN_ANGLE_DEG = 5.0
@@ -50,6 +65,25 @@ SNAP_S = 0.5 / 25.0
 #: reaches (eq. 5.6's "full reach"): a fully straight limb is a singular pose,
 #: so the virtual dancer (``synthetic.limbs.apply_move``) stops 0.1 % short.
 REACH_MARGIN = 0.999
+#: Window refinement (:func:`refine_window`): an edge is moved outward only
+#: over frames where the extremity turns faster than this fraction of the
+#: movement's peak angular speed inside the given window.
+MOVING_FRACTION = 0.1
+#: The start is followed down its (monotone) rising flank to this fraction of
+#: the peak speed, or to the jitter floor (:func:`_speed_noise`) if higher.
+#: 0: the logistic starts from rest, and a level cut off its slow first part
+#: biases b (a start 3 frames late of 50 reads b = −3.4 as −2.9); a hold, the
+#: previous movement's stop (speed rising outward) or a corner of the path
+#: ends the flank.
+START_FRACTION = 0.0
+#: Largest outward move of each window edge, as a fraction of the window's
+#: duration (a captured symbol rarely misses more than a quarter beat of a
+#: 1-beat movement at either end).
+MAX_EXTEND = 0.5
+#: At a movement's end the logistic stops with finite speed (or the next
+#: movement starts from rest), so the speed drops suddenly: an end is not
+#: moved over a frame whose speed is below this fraction of the previous one.
+END_DROP = 0.5
 
 
 @dataclass(frozen=True)
@@ -153,6 +187,186 @@ def _endpoint(t, times, rel, conf, ok, where, inward: int):
         return rel[i0], conf[i0]
     w = (t - times[i0]) / (times[i1] - times[i0])
     return (1 - w) * rel[i0] + w * rel[i1], min(conf[i0], conf[i1])
+
+
+def _interval_speed(u: np.ndarray, good: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Angular speed (rad/s) of unit directions `u` (T, 3) over each frame interval (T−1,).
+
+    Unsmoothed: a smoothing kernel would spread a movement's abrupt stop
+    into the next interval and move exact (truth) windows.  Intervals
+    touching an invalid frame get NaN (never bridged).
+    """
+    speed = _angle(u[:-1], u[1:]) / np.diff(times)
+    return np.where(good[:-1] & good[1:], speed, np.nan)
+
+
+#: An edge moves over a step only if the path does not turn by more than
+#: 45° there (cosine between successive displacements): within a movement
+#: the extremity's path is smooth, between two movements it has a corner.
+MIN_TURN_COS = np.cos(np.radians(45.0))
+#: Jitter-driven speed is ignored up to this many of its standard deviations
+#: (``refine_window``): a 2-D Gaussian's norm exceeds 3 sd with p ≈ 1 %.
+NOISE_SIGMAS = 3.0
+
+
+def _speed_noise(u: np.ndarray, good: np.ndarray, dt: float) -> float:
+    """Speed (rad/s) up to which frame-to-frame jitter of directions `u` (T, 3) explains a step.
+
+    The jitter σ (rad, per tangent component) is read from the third
+    differences of the direction, whose jitter part has sd √20·σ per
+    component while a smooth movement adds almost nothing (jerk·Δt³; second
+    differences would count a fast movement's acceleration as noise);
+    robust median, the norm of a 2-D Gaussian having median 1.177 sd.  A
+    step's jitter has sd √2·σ per component; :data:`NOISE_SIGMAS` of it,
+    divided by the frame step, is returned (≈ 0 for noise-free data).
+    """
+    ok = good[3:] & good[2:-1] & good[1:-2] & good[:-3]
+    if not ok.any():
+        return 0.0
+    d3 = np.linalg.norm(u[3:] - 3.0 * u[2:-1] + 3.0 * u[1:-2] - u[:-3], axis=1)[ok]
+    sigma = float(np.median(d3)) / (1.177 * np.sqrt(20.0))
+    return NOISE_SIGMAS * np.sqrt(2.0) * sigma / dt
+
+
+def refine_window(
+    joints: np.ndarray,
+    confidence: np.ndarray | None,
+    times: np.ndarray,
+    part: str,
+    t_start: float,
+    t_end: float,
+    bounds: tuple = (-np.inf, np.inf),
+    joint_names=JOINTS,
+    moving: float = MOVING_FRACTION,
+    max_extend: float = MAX_EXTEND,
+) -> tuple:
+    """Move a movement window's edges outward to where the extremity really starts and stops.
+
+    Windows of a *captured* score (symbol start and end quantised from the
+    fitted joints) are often cut short or shifted by a fraction of a beat; a
+    progress curve measured from a late start or to an early end looks more
+    linear (b less negative) and shifts x0.  The extremity's own motion says
+    where the movement is, so each edge is moved outward over the frames on
+    which the segment's direction is still clearly turning as part of this
+    movement:
+
+    * start: back over frame intervals whose angular speed exceeds
+      :data:`START_FRACTION` × the peak speed inside the window *and* keeps
+      falling outward (the
+      rising flank of this movement; a hold or the previous movement's
+      abrupt stop ends it);
+    * end: forward over intervals faster than `moving` × peak, without a
+      sudden drop (below :data:`END_DROP` of the previous interval: the
+      logistic stops with finite speed, or the next movement starts from
+      rest) and, after the first step, without rising again (a new
+      movement);
+    * both: only where the path turns by less than 45° from one step to
+      the next (:data:`MIN_TURN_COS`): a boundary between movements is a
+      corner of the extremity's path.
+
+    Edges never move inward: the logistic starts from rest (ds/dτ = 0 at
+    τ = 0), so a slow start is indistinguishable from a hold by speed, and
+    only the score can place it.  A window taken from a clean render
+    (truth score) is therefore left unchanged: before its start the part
+    holds or the previous movement stops abruptly, after its end the speed
+    drops suddenly.  Speeds are frame to frame (unsmoothed); missing frames
+    stop the search; jitter is kept from moving an edge by a speed floor
+    estimated from the data (:func:`_speed_noise`).  An edge between frames starts the search from the
+    nearest frame inside the window.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joint positions, metres; NaN where missing.
+    confidence : (T, J) ndarray or None
+        Per-frame confidence; frames with 0 are invalid.
+    times : (T,) ndarray
+        Frame times, seconds.
+    part : str
+        Gesture part (key of ``PART_SEGMENTS``).
+    t_start, t_end : float
+        Window from the score, seconds.
+    bounds : (float, float)
+        Limits no edge may cross, seconds (e.g. the middle of the
+        neighbouring movements of the same part).
+    joint_names : sequence of str
+    moving : float
+        Fraction of the peak speed above which an end is moved outward.
+    max_extend : float
+        Largest move of each edge, as a fraction of ``t_end − t_start``.
+
+    Returns
+    -------
+    t_start, t_end : float
+        Refined window, seconds (the given values where nothing moved).
+    """
+    names = list(joint_names)
+    if part not in PART_SEGMENTS or not all(j in names for j in PART_SEGMENTS[part]):
+        return float(t_start), float(t_end)
+    bound, free = (names.index(j) for j in PART_SEGMENTS[part])
+    times = np.asarray(times, dtype=float)
+    rel = np.asarray(joints, dtype=float)[:, free] - np.asarray(joints, dtype=float)[:, bound]
+    good = np.all(np.isfinite(rel), axis=1)
+    if confidence is not None:
+        conf = np.nan_to_num(np.asarray(confidence, dtype=float), nan=0.0)
+        good &= np.minimum(conf[:, free], conf[:, bound]) > 0
+    norm = np.linalg.norm(np.nan_to_num(rel), axis=1)
+    good &= norm > 1e-6
+    if times.size < 3 or good.sum() < 3:
+        return float(t_start), float(t_end)
+    u = np.nan_to_num(rel) / np.where(norm > 1e-6, norm, 1.0)[:, None]
+    speed = _interval_speed(u, good, times)  # (T-1,), interval k = [times[k], times[k+1]]
+    dt = float(np.median(np.diff(times)))
+    noise = _speed_noise(u, good, dt)
+    tol = 1e-6 * dt
+    # the nearest frames inside the window (the edges themselves when snapped)
+    i0 = int(np.searchsorted(times, t_start - tol))
+    i1 = int(np.searchsorted(times, t_end + tol)) - 1
+    on0 = 0 < i0 < i1
+    on1 = i0 < i1 < times.size - 1
+    inside = speed[i0:max(i1, i0)]
+    if inside.size == 0 or not np.any(np.isfinite(inside)):
+        return float(t_start), float(t_end)
+    # cosine between successive steps' displacements (T-2,): a movement's
+    # path is smooth, a boundary between two movements is a corner
+    step = np.diff(u, axis=0)
+    step /= np.maximum(np.linalg.norm(step, axis=1, keepdims=True), 1e-12)
+    turn = np.einsum("ij,ij->i", step[:-1], step[1:])
+    peak = float(np.nanmax(inside))
+    # jitter alone must not move an edge: both floors at least NOISE_SIGMAS
+    # noise levels above the speed that frame-to-frame jitter gives
+    floor = max(moving * peak, noise)
+    floor0 = max(START_FRACTION * peak, noise)
+    reach = max_extend * (t_end - t_start)
+    lo = max(t_start - reach, bounds[0])
+    hi = min(t_end + reach, bounds[1])
+    new0, new1 = float(t_start), float(t_end)
+    if on0:
+        k = i0 - 1  # interval ending at the edge
+        # the rising flank may be followed far down (the logistic starts from
+        # rest): its monotone fall, not a speed level, marks this movement
+        while (
+            k >= 0
+            and times[k] >= lo - tol
+            and speed[k] > floor0
+            and speed[k] < speed[k + 1]
+            and turn[k] > MIN_TURN_COS
+        ):
+            k -= 1
+        new0 = min(float(times[k + 1]), new0) if k + 1 < i0 else new0
+    if on1:
+        k = i1  # interval starting at the edge
+        while (
+            k < speed.size
+            and times[k + 1] <= hi + tol
+            and speed[k] > floor
+            and speed[k] >= END_DROP * speed[k - 1]
+            and (k == i1 or speed[k] <= speed[k - 1])
+            and turn[k - 1] > MIN_TURN_COS
+        ):
+            k += 1
+        new1 = max(float(times[k]), new1) if k > i1 else new1
+    return new0, new1
 
 
 def limb_reach(joints: np.ndarray, ok: np.ndarray, bound: int, middle: int, free: int) -> float:

@@ -16,7 +16,7 @@ import numpy as np
 from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS, Score
-from .curves import SNAP_S, ProgressCurve, progress_curve
+from .curves import SNAP_S, ProgressCurve, _snap, progress_curve, refine_window
 from .emotion import emotion_probabilities, features
 from .fit import SpaceEstimate
 from .pooled import PooledEffort, curve_space, pool_curves, pooled_space
@@ -117,6 +117,28 @@ def _pooled_dict(p: PooledEffort) -> dict:
     return {"n_movements": p.n_movements, **_effort_fields(p.posterior, p.space)}
 
 
+def _neighbour_bounds(windows) -> list:
+    """Per window, the (lo, hi) seconds its refinement may not cross.
+
+    The middle of the previous and of the next window of the same part:
+    a captured score often splits one movement in two (e.g. a bend change
+    quantised as its own symbol), and each half may then reach into the
+    other, but never past its middle (where the neighbour is surely moving).
+    """
+    out = [(-np.inf, np.inf)] * len(windows)
+    by_part: dict = {}
+    for i, (sym, t0, t1) in enumerate(windows):
+        by_part.setdefault(sym.part, []).append(i)
+    for idx in by_part.values():
+        idx = sorted(idx, key=lambda i: windows[i][1])
+        mids = [0.5 * (windows[i][1] + windows[i][2]) for i in idx]
+        for j, i in enumerate(idx):
+            lo = mids[j - 1] if j > 0 else -np.inf
+            hi = mids[j + 1] if j + 1 < len(idx) else np.inf
+            out[i] = (lo, hi)
+    return out
+
+
 def movement_windows(score: Score, times: np.ndarray) -> list:
     """Gesture symbols with their windows in seconds.
 
@@ -178,6 +200,7 @@ def estimate_effort(
     sampler_kw: dict | None = None,
     per_movement: bool = True,
     snap: float = SNAP_S,
+    refine: bool = True,
 ) -> EffortResult:
     """Estimate Laban Effort per movement, pooled per part and phrase, and the emotion.
 
@@ -209,6 +232,12 @@ def estimate_effort(
     snap : float
         Snap window ends to frames within this many seconds (see
         :func:`.curves.progress_curve`).
+    refine : bool
+        Move each window's edges outward to where the extremity really
+        starts and stops (:func:`.curves.refine_window`), bounded by the
+        middle of the neighbouring movements of the same part.  Windows of a
+        clean render are left unchanged; those of a captured score are often
+        cut short by a fraction of a beat.
 
     Returns
     -------
@@ -228,11 +257,18 @@ def estimate_effort(
     kw = dict(sampler_kw or {})
 
     curves, syms, skipped = [], [], []
-    for sym, t0, t1 in movement_windows(score, times):
+    windows = movement_windows(score, times)
+    limits = _neighbour_bounds(windows)
+    for (sym, t0, t1), lim in zip(windows, limits):
         where = {"part": sym.part, "start": float(sym.start), "duration": float(sym.duration)}
         if t0 < times[0] or t1 > times[-1] + 0.5 / fps:
             skipped.append({**where, "reason": f"window {t0:.3f}-{t1:.3f} s outside the capture"})
             continue
+        if refine:
+            if snap > 0:
+                t0, t1 = _snap(t0, times, snap), _snap(t1, times, snap)
+            if t1 > t0:
+                t0, t1 = refine_window(joints, confidence, times, sym.part, t0, t1, lim, joint_names)
         try:
             c = progress_curve(joints, confidence, times, sym.part, t0, t1, joint_names, snap=snap)
         except EffortError as exc:
