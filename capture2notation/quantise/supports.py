@@ -25,7 +25,8 @@ Noisy motion (fitted joints, mocap: jitter above :data:`NOISY_POSITION_M`)
 has speeds as large as a plié's from the jitter alone, so there the
 movements are the changes of the mode-filtered support state instead,
 timed by the Effort logistic fitted to the pelvis
-(:func:`_noisy_support_movements`).  A single-view fit also floats and
+(:func:`_noisy_support_movements`; a closing by its landing foot,
+:mod:`.landing`, as the fitted pelvis lags).  A single-view fit also floats and
 sinks the feet by centimetres and barely bends a knee seen from the front,
 so there a foot flickering out of contact with the pelvis still between
 the feet keeps supporting (:func:`_balanced_contacts`), pliés are read from
@@ -280,6 +281,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     flicker and writes nothing.
     """
     from .segment import Movement
+    from .landing import closing_times
     from .timing import refine_times
 
     T = joints.shape[0]
@@ -340,12 +342,19 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
             # The pelvis did not move: contact flicker, not a support change.
             continue
         (t0, t1), = refine_times([win])
+        if new_part == 0 and state[0] > 0:
+            # A closing arrives when the free foot lands: its own travel is
+            # sharper (and on time) where the fitted pelvis lags.
+            free = 2 - state[0]
+            times = closing_times(smooth[:, joint_index(("right_ankle", "left_ankle")[free])],
+                                  labels.supporting[:, free], min(prev_start, out[-1].start_frame if out else 0), a, fps)
+            t0, t1 = times if times is not None else (t0, t1)
         start = int(np.clip(round(t0 * fps), 0, T - 1))
         end = int(np.clip(round(t1 * fps), start + 1, T - 1))
         state = new
         out.append(Movement(_SUPPORT_PARTS[new_part], start, end, max(t0, 0.0), t1, direction, LEVELS[new_level], 0))
         prev_start, prev_end = a, b
-    return _join_flights(out)
+    return _join_flights(out, smooth)
 
 
 #: A weight transfer onto one foot that the other foot's step follows
@@ -353,7 +362,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
 FLIGHT_GAP_S = 0.5
 
 
-def _join_flights(moves: list) -> list:
+def _join_flights(moves: list, joints: np.ndarray | None = None) -> list:
     """Support movements with each step's flight made part of the step.
 
     While one foot swings through a step the weight is on the other foot
@@ -362,18 +371,50 @@ def _join_flights(moves: list) -> list:
     A notator writes the step from the moment the weight leaves: when the
     step onto the other foot follows within :data:`FLIGHT_GAP_S` (the
     pelvis never settled), the transfer is dropped and the step starts
-    where it started.
+    where it started.  But a transfer that brought the pelvis over its
+    foot (:func:`_pelvis_over_foot`, given the smoothed `joints`) is a
+    written weight transfer, however quickly a step follows it: a flight
+    leaves the pelvis between the feet or carries it towards the step.
     """
     out: list = []
     for m in moves:
         prev = out[-1] if out else None
         if (prev is not None and m.direction != "place" and prev.direction == "place"
                 and {prev.part, m.part} == {"right_support", "left_support"}
-                and m.start_time - prev.end_time < FLIGHT_GAP_S):
+                and m.start_time - prev.end_time < FLIGHT_GAP_S
+                and not (joints is not None and _pelvis_over_foot(joints, prev))):
             out[-1] = replace(m, start_frame=prev.start_frame, start_time=prev.start_time)
             continue
         out.append(m)
     return out
+
+
+#: Fraction of the way from one foot to the other within which the pelvis
+#: is over the nearer foot (as :func:`weight_bearing` judges it).
+OVER_FOOT_FRACTION = 0.25
+
+
+def _pelvis_over_foot(joints: np.ndarray, move) -> bool:
+    """Whether a one-foot support movement ends with the pelvis over its foot.
+
+    The pelvis at the movement's arrival frame, along the line between the
+    feet where they stood at its start: a stepping foot may already have
+    moved at the arrival (and a fitted one shifts back before it leaves),
+    which would put the line under a pelvis that never went over a foot.
+    """
+    T = joints.shape[0]
+    a = int(np.clip(move.start_frame, 0, T - 1))
+    f = int(np.clip(move.end_frame, 0, T - 1))
+    pelvis = joints[f, joint_index("pelvis"), :2]
+    fr = joints[a, joint_index("right_ankle"), :2]
+    d = joints[a, joint_index("left_ankle"), :2] - fr
+    n2 = float(d @ d)
+    if not n2 > 1e-6:
+        return False
+    u = float((pelvis - fr) @ d) / n2
+    if move.part == "right_support":
+        return u < OVER_FOOT_FRACTION
+    return u > 1.0 - OVER_FOOT_FRACTION
 
 
 #: A fitted foot counted off the floor while the pelvis stays between the

@@ -187,3 +187,81 @@ def test_fitted_steps_keep_their_direction_and_their_flight():
         assert steps == [("right_support", "forward"), ("left_support", "left"), ("right_support", "back")], steps
         agree.append(compare_scores(score, got).symbol_agreement)
     assert np.mean(agree) >= 0.85, agree
+
+
+def _interpret(text):
+    import warnings
+
+    from capture2notation.notation.formats import loads
+    from synthetic.interpret import interpret
+
+    score = loads(text, "lab")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return score, interpret(score, fps=FPS).joints()
+
+
+TRANSFER_THEN_STEP = """\
+title: quick transfer then a step
+tempo: 100
+meter: 4
+0  1   left_support  place   middle
+1  1   right_support forward middle
+2  2   support       place   middle
+4  1   right_support place   middle
+5  1   left_support  left    middle
+6  2   support       place   middle
+"""
+
+
+def test_a_transfer_that_a_step_follows_at_once_is_kept():
+    """A weight transfer onto the left foot, then at once a step forward
+    onto the right: the transfer was taken for the step's flight (the
+    weight on the other foot while the stepping foot swings) and merged
+    into the step.  A flight leaves the pelvis between the feet; a
+    transfer takes it over its foot."""
+    score, joints = _interpret(TRANSFER_THEN_STEP)
+    feet = [joint_index(n) for n in ("right_ankle", "right_toe", "left_ankle", "left_toe")]
+    for seed in (0, 1):
+        noisy = joints + _correlated(joints.shape, 0.006, seed, width_frames=3.0)
+        noisy[:, feet, 1] -= 0.10
+        sup = [(p, d) for _, _, p, d, _ in _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)]
+        assert sup[:2] == [("left_support", "place"), ("right_support", "forward")], sup
+        assert ("right_support", "place") in sup and ("left_support", "left") in sup, sup
+
+
+STEP_CLOSE_HOLD = """\
+title: steps, each closed and held
+tempo: 76
+meter: 4
+0  1   right_support forward middle
+1  1   support       place   middle
+3  1   left_support  left    middle
+4  1   support       place   middle
+6  1   right_support back    middle
+7  1   support       place   middle
+9  1   right_arm     forward low
+"""
+
+
+def test_a_closing_is_timed_by_the_landing_foot_not_the_lagging_pelvis():
+    """A fit smooths the pelvis: it moves a quarter of a second after the
+    feet.  Timed from the pelvis, each closing was written half a beat
+    late (its cell lost); the closing foot lands on time.  (The arm
+    gesture keeps the clip going past the last closing: one landing on
+    the clip's last frame is never held long enough to be seen.)"""
+    score, joints = _interpret(STEP_CLOSE_HOLD)
+    lag = 4
+    legs = {joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("ankle", "toe")}
+    body = [j for j in range(joints.shape[1]) if j not in legs]
+    lagged = joints.copy()
+    lagged[lag:, body] = joints[:-lag, body]
+    lagged[:lag, body] = joints[:1, body]
+    for seed in (0, 1):
+        noisy = lagged + _correlated(joints.shape, 0.004, seed, width_frames=3.0)
+        got = _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)
+        closes = [start for start, _, p, d, _ in got if p == "support" and d == "place"]
+        assert len(closes) == 3, got
+        for want, start in zip((1, 4, 7), closes):
+            assert abs(start - want) <= F(1, 4), got
+
