@@ -85,3 +85,29 @@ def test_the_leg_meets_the_shoe_at_the_ankle_joint():
         px_per_h = cam.K[1, 1] * H / cam.depth(ankle)
         tol = 0.015 * px_per_h
         assert trousers.max() - tol <= cam.project(ankle)[1] <= shoe.min() + tol, (view, cam.project(ankle)[1], text)
+
+
+def _is_shirt(bgr) -> bool:
+    b, g, r = bgr
+    return r > g + 60 and r > b + 40
+
+
+def test_the_sleeve_ends_at_the_elbow_in_a_cuff_wider_than_the_forearm():
+    """A hanging arm seen from the front: the sleeve stands off the arm and stops at the elbow.
+
+    A sleeve as thin as the arm left nothing of the upper arm to see when it
+    pointed at the camera in the side view; BlazePose then put the elbow
+    half-way up the forearm.
+    """
+    cam = Camera.for_view("front", (640, 480), H)
+    pose = _pose()
+    img = make_renderer(pose, cam, "mannequin").frame(0)
+    elbow, shoulder = pose.points["right_elbow"][0], pose.points["right_shoulder"][0]
+    down = (elbow - shoulder) / np.linalg.norm(elbow - shoulder)
+    side = np.cross(down, cam.position - elbow)
+    side /= np.linalg.norm(side)
+    for sign in (1.0, -1.0):
+        # Between the forearm's radius (0.026 H) and the sleeve's (0.036 H).
+        out = sign * 0.031 * H * side
+        assert _is_shirt(_patch(img, cam.project(elbow - 0.015 * H * down + out), r=1))
+        assert not _is_shirt(_patch(img, cam.project(elbow + 0.05 * H * down + out), r=1))
