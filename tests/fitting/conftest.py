@@ -35,6 +35,14 @@ def make_motion(T: int, seed: int, fps: float = 25.0, body: Body | None = None):
     return body.clip(ang), root
 
 
+def held_pose(T: int, body: Body, **angles):
+    """Angles (T, J, 3) and root (T, 3) of a standing figure with some joints held at given Euler angles."""
+    ang = np.zeros((T, len(JOINTS), 3))
+    for name, value in angles.items():
+        ang[:, joint_index(name)] = value
+    return body.clip(ang), np.tile(body.rest[0], (T, 1))
+
+
 def observe(angles, root, camera: Camera, body: Body | None = None, noise_px: float = 0.0, seed: int = 0):
     """BlazePose-like observations of a pose: (xy (T,33,2), conf (T,33), world (T,33,3), joints (T,J,3))."""
     body = body or Body()
@@ -75,4 +83,5 @@ def synth():
     """The helpers above: ``synth.make_motion``, ``synth.observe``, ``synth.limb_direction_errors``."""
     from types import SimpleNamespace
 
-    return SimpleNamespace(make_motion=make_motion, observe=observe, limb_direction_errors=limb_direction_errors)
+    return SimpleNamespace(make_motion=make_motion, held_pose=held_pose, observe=observe,
+                           limb_direction_errors=limb_direction_errors)

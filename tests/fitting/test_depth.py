@@ -2,19 +2,12 @@
 
 import numpy as np
 
-from capture2notation.body import JOINTS, Body, joint_index
+from capture2notation.body import Body, joint_index
 from capture2notation.fitting import Camera, FitOptions, fit_keypoints
 from capture2notation.fitting.depth import arm_candidates, viterbi
 
 CAM = Camera.default((640, 480))
 T = 30
-
-
-def _standing(body, **angles):
-    ang = np.zeros((T, len(JOINTS), 3))
-    for name, value in angles.items():
-        ang[:, joint_index(name)] = value
-    return body.clip(ang), np.tile(body.rest[0], (T, 1))
 
 
 def _depth_sign(joints, a, b):
@@ -57,7 +50,7 @@ def test_an_arm_pointing_forward_stays_forward_when_the_world_depth_flips_in_som
     # third frame; continuity and the other frames must keep the arm in front,
     # without a depth flip between frames.
     body = Body()
-    ang, root = _standing(body, right_shoulder=(1.3, 0.0, 0.0))
+    ang, root = synth.held_pose(T, body, right_shoulder=(1.3, 0.0, 0.0))
     xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=3)
     world = world + np.random.default_rng(4).normal(0.0, 0.02, world.shape)
     bad = np.arange(T) % 3 == 1
@@ -75,7 +68,7 @@ def test_a_bent_elbow_tells_the_forearm_side_when_world_depth_says_nothing(synth
     # landmarks are flattened onto the image plane, so only the elbow's one
     # bending direction says in front: the fit must put the hand in front.
     body = Body()
-    ang, root = _standing(body, right_elbow=(1.5, 0.0, 0.0))
+    ang, root = synth.held_pose(T, body, right_elbow=(1.5, 0.0, 0.0))
     xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=8)
     world[:, [16, 20], 2] = world[:, [14], 2]
     assert np.all(_depth_sign(truth, "right_elbow", "right_wrist") < 0)

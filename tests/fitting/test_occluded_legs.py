@@ -17,13 +17,6 @@ CAM = Camera.default((640, 480))
 T = 30
 
 
-def _standing(body, **angles):
-    ang = np.zeros((T, len(JOINTS), 3))
-    for name, value in angles.items():
-        ang[:, joint_index(name)] = value
-    return body.clip(ang), np.tile(body.rest[0], (T, 1))
-
-
 def _hide(xy, conf, world, landmarks):
     for lm in landmarks:
         xy[:, lm], conf[:, lm], world[:, lm] = np.nan, 0.0, np.nan
@@ -44,7 +37,7 @@ def test_a_thigh_raised_at_the_camera_with_its_hip_and_ankle_hidden_points_at_th
     # the hidden hip was placed from the hip-centred origin, the thigh lost
     # its world direction and was fitted pointing back (~150° off).
     body = Body()
-    ang, root = _standing(body, left_hip=(1.3, 0.0, 0.0), left_knee=(-1.3, 0.0, 0.0))
+    ang, root = synth.held_pose(T, body, left_hip=(1.3, 0.0, 0.0), left_knee=(-1.3, 0.0, 0.0))
     xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=5)
     world = world + np.random.default_rng(6).normal(0.0, 0.03, world.shape)
     _hide(xy, conf, world, (23, 27))
@@ -60,7 +53,7 @@ def test_a_leg_raised_straight_at_the_camera_with_its_knee_hidden_points_at_the_
     # The knee hides behind the foot: hip → ankle must stand in for the
     # thigh's and shin's directions (before: fitted 130–170° off, back).
     body = Body()
-    ang, root = _standing(body, left_hip=(1.4, 0.0, 0.0))
+    ang, root = synth.held_pose(T, body, left_hip=(1.4, 0.0, 0.0))
     xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=7)
     world = world + np.random.default_rng(8).normal(0.0, 0.03, world.shape)
     _hide(xy, conf, world, (25,))

@@ -25,15 +25,6 @@ T = 30
 CAM = Camera.default((640, 480))
 
 
-def _standing(T, body, **angles):
-    """Angles (T, J, 3) of a standing figure with some joints held at given Euler angles."""
-    ang = np.zeros((T, len(JOINTS), 3))
-    for name, value in angles.items():
-        ang[:, joint_index(name)] = value
-    root = np.tile(body.rest[0], (T, 1))
-    return body.clip(ang), root
-
-
 def _labels(joints, part):
     lab = label_frames(joints, 25.0)
     i = lab.index(part)
@@ -45,7 +36,7 @@ def test_an_arm_pointing_at_or_away_from_the_camera_is_recovered_on_the_right_si
     # Seen from the front, forward-middle and back-low arms are short stubs in
     # the image; only the world landmarks say in front or behind.
     body = Body()
-    ang, root = _standing(T, body, right_shoulder=(rx, 0.0, 0.0))
+    ang, root = synth.held_pose(T, body, right_shoulder=(rx, 0.0, 0.0))
     xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=5)
     world = world + np.random.default_rng(6).normal(0.0, 0.02, world.shape)
     res = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world)
@@ -58,7 +49,7 @@ def test_trunk_stays_upright_when_world_landmarks_lean_it_towards_the_camera(syn
     # BlazePose's world landmarks of a front view put the shoulders 20-40°
     # towards the camera; the image says the trunk is upright.
     body = Body()
-    ang, root = _standing(T, body, right_shoulder=(0.0, -1.2, 0.0), left_shoulder=(0.0, 1.2, 0.0))
+    ang, root = synth.held_pose(T, body, right_shoulder=(0.0, -1.2, 0.0), left_shoulder=(0.0, 1.2, 0.0))
     xy, conf, world, _ = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=7)
     lean = np.radians(35.0)  # rotate the upper body about the hip axis, towards the camera (camera -z)
     c, s = np.cos(lean), np.sin(lean)
@@ -94,7 +85,7 @@ def test_noisy_observations_of_a_dance_give_the_true_labels(synth):
 
 def _standing_fit(synth, noise_px, options):
     body = Body()
-    ang, root = _standing(40, body, right_shoulder=(1.2, 0.0, 0.0), left_elbow=(0.8, 0.0, 0.0))
+    ang, root = synth.held_pose(40, body, right_shoulder=(1.2, 0.0, 0.0), left_elbow=(0.8, 0.0, 0.0))
     xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=noise_px, seed=21)
     world = world + np.random.default_rng(22).normal(0.0, 0.03, world.shape)
     return fit_keypoints(xy, conf, 25.0, camera=CAM, world=world, options=options), truth
@@ -153,12 +144,12 @@ def test_smooth_root_removes_depth_jitter_from_a_steady_walk():
     assert np.all((out[:, 3:] >= model.lower[3:]) & (out[:, 3:] <= model.upper[3:]))
 
 
-def test_direction_spread_follows_the_evidence():
+def test_direction_spread_follows_the_evidence(synth):
     # Through one camera a segment lying across the image has its depth set
     # only to second order (foreshortening), one seen end-on to first order;
     # world landmarks (a direction prior) narrow the spread of both.
     body = Body()
-    ang, root = _standing(5, body, right_shoulder=(np.pi / 2, 0.0, 0.0), left_shoulder=(0.0, np.pi / 2, 0.0))
+    ang, root = synth.held_pose(5, body, right_shoulder=(np.pi / 2, 0.0, 0.0), left_shoulder=(0.0, np.pi / 2, 0.0))
     xy, conf, world = _clean_observations(ang, root, body)
     opt = FitOptions()
     spreads = []
