@@ -15,7 +15,8 @@ import numpy as np
 
 from .labels import FrameLabels
 
-__all__ = ["TRUNK_MAX_BIAS_DEG", "TRUNK_MAX_MARGIN_DEG", "upright_trunk"]
+__all__ = ["HYSTERESIS_DEG", "TRUNK_MAX_BIAS_DEG", "TRUNK_MAX_MARGIN_DEG", "held_pose", "hold_frames", "keep_previous",
+           "upright_trunk"]
 
 #: A part's clip-median direction within this of vertical is taken as a
 #: fit's bias of the upright pose; farther, the dancer holds a real tilt.
@@ -83,3 +84,139 @@ def upright_trunk(labels: FrameLabels, part: str) -> tuple[FrameLabels, float]:
     tilt = np.degrees(np.arccos(np.clip(vectors[ok, col, 2], -1.0, 1.0)))
     margin = min(TRUNK_MAX_MARGIN_DEG, float(np.percentile(tilt, 90)))
     return replace(labels, vectors=vectors), margin
+
+
+#: Hysteresis of measured labels, degrees: a fitted limb direction is off by
+#: 3-6° (more than that on a depth-ambiguous part), so a held pose within
+#: this of the previous symbol's sector, or a bend within this of the
+#: previous bend degree's band, keeps the previous symbol instead of flipping
+#: on the fit's own error.
+HYSTERESIS_DEG = 6.0
+
+
+def held_pose(vectors: np.ndarray, bend_deg: np.ndarray | None, frames: slice) -> tuple[np.ndarray, float]:
+    """Robust pose of one gesture column over the frames of a hold.
+
+    The component-wise median (renormalised) and the median bend: a fitted
+    hold flickers for a frame or two (a depth flip, a swapped limb) and a
+    mean is pulled across a sector boundary by them, a median is not.
+
+    Parameters
+    ----------
+    vectors : (T, 3) ndarray
+        Unit body-frame vectors of the column; NaN where undefined.
+    bend_deg : (T,) ndarray or None
+        The column's bend β, degrees (limbs).
+    frames : slice
+
+    Returns
+    -------
+    v : (3,) ndarray
+        Unit vector (NaN when no frame is defined).
+    bend : float
+        Degrees; NaN without a bend.
+    """
+    seg = vectors[frames]
+    ok = np.isfinite(seg).all(axis=-1)
+    if not ok.any():
+        return np.full(3, np.nan), float("nan")
+    v = np.median(seg[ok], axis=0)
+    n = float(np.linalg.norm(v))
+    v = v / n if n > 0 else np.full(3, np.nan)
+    if bend_deg is None:
+        return v, float("nan")
+    b = bend_deg[frames]
+    return v, float(np.median(b[np.isfinite(b)])) if np.isfinite(b).any() else float("nan")
+
+
+def hold_frames(arrival: int, span_end: int, next_start: int, hold: int, T: int, min_frames: int = 3) -> slice:
+    """Frames over which a measured movement's arrival pose is read.
+
+    From the fitted arrival over up to `hold` frames of the hold, ending where
+    the next movement of the part starts.  A fitted arrival later than that
+    start (the logistic overshoots into a chained movement) would leave a
+    single frame, or frames of the next movement: the hold then starts where
+    the speed fell below its threshold (`span_end`).  At least `min_frames`
+    frames are read, so that one flickering frame never decides a label.
+
+    Parameters
+    ----------
+    arrival : int
+        Frame of the fitted arrival.
+    span_end : int
+        First frame after the detected motion (speed below threshold).
+    next_start : int
+        First frame of the part's next movement (``T`` when none).
+    hold : int
+        Longest hold read, frames.
+    T : int
+        Number of frames.
+    min_frames : int
+
+    Returns
+    -------
+    slice
+    """
+    lo = arrival if arrival < next_start else min(span_end, arrival)
+    hi = max(lo + min_frames, min(lo + hold, next_start + 1))
+    hi = min(hi, T)
+    lo = max(0, min(lo, hi - min_frames))
+    return slice(lo, hi)
+
+
+def _sector_label(v: np.ndarray) -> tuple[str, str]:
+    from ..notation.directions import classify
+
+    return classify(v)
+
+
+def _toward(v: np.ndarray, c: np.ndarray, deg: float) -> np.ndarray:
+    """`v` rotated towards `c` by `deg` degrees on their great circle (or onto `c` when nearer)."""
+    ang = float(np.arccos(np.clip(v @ c, -1.0, 1.0)))
+    step = np.radians(deg)
+    if ang <= step or ang < 1e-9:
+        return c.copy()
+    w = c - (v @ c) * v
+    w /= np.linalg.norm(w)
+    return np.cos(step) * v + np.sin(step) * w
+
+
+def keep_previous(v: np.ndarray, bend: float, label: tuple[str, str, int], previous: tuple[str, str, int],
+                  margin: float = HYSTERESIS_DEG) -> tuple[str, str, int]:
+    """Label of a measured held pose with hysteresis against the part's previous symbol.
+
+    The previous direction and level are kept when the pose lies within
+    `margin` degrees of the previous symbol's sector (moving it `margin`
+    degrees towards the previous canonical vector classifies it there), and
+    the previous bend degree when β is within `margin` of its 30° band.  A
+    pose well inside another sector changes the label as before.
+
+    Parameters
+    ----------
+    v : (3,) ndarray
+        Unit held vector.
+    bend : float
+        Held bend β, degrees (NaN: no bend).
+    label : (direction, level, bend)
+        The pose's own label.
+    previous : (direction, level, bend)
+        The part's previous symbol (its starting pose before any).
+    margin : float
+        Degrees.
+
+    Returns
+    -------
+    (direction, level, bend)
+    """
+    from ..notation.directions import BEND_STEP_DEG, canonical_vector
+
+    d, lv, k = label
+    pd, plv, pk = previous
+    if not pd or not np.isfinite(v).all():
+        return label
+    if (d, lv) != (pd, plv) and not (pd == "place" and plv == "middle"):
+        if _sector_label(_toward(v, canonical_vector(pd, plv), margin)) == (pd, plv):
+            d, lv = pd, plv
+    if k != pk and pk >= 0 and np.isfinite(bend) and abs(bend - BEND_STEP_DEG * pk) < BEND_STEP_DEG / 2 + margin:
+        k = pk
+    return d, lv, k

@@ -31,9 +31,13 @@ Noisy motion (fitted, mocap)
     (:mod:`.timing`) — a speed threshold cuts a fifth to a third off each
     end — and it must last :data:`_MIN_MOVE_S` or hold its arrival pose for
     :data:`_HOLD_S` (quicker swings that do not hold are glitches of the
-    fit); its label is the mean pose over up to :data:`_HOLD_S` of
-    the hold after the arrival, and it is written only when that label
-    differs from the part's previous one.  Key times of different parts
+    fit); its label is the median pose over up to :data:`_HOLD_S` of
+    the hold after the arrival (:func:`~.measured.hold_frames`), and it is
+    written only when that label differs from the part's previous one —
+    with hysteresis (:func:`~.measured.keep_previous`: a pose within a few
+    degrees of the previous symbol's sector or bend band keeps it) and not
+    when the held pose is within :data:`_SAME_POSE_DEG` of the last written
+    one (a label change there is only a boundary crossed by the fit's error).  Key times of different parts
     within ``merge_window_s`` are pulled together.  A fitted chest is read
     from its own upright and must tilt past the fit's trunk noise
     (:func:`~.measured.upright_trunk`).  Feet contacts come from
@@ -72,7 +76,7 @@ from scipy.signal import savgol_filter
 from ..errors import QuantiseError
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
-from .measured import upright_trunk
+from .measured import held_pose, hold_frames, keep_previous, upright_trunk
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .spans import _ZERO_SPEED, movement_spans
 from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
@@ -193,6 +197,9 @@ _MIN_MOVE_S = 0.2
 _NEAR_POSE_DEG = 15.0
 #: Tilt from vertical where a trunk part leaves place high (DESIGN.md).
 _TILT_DEG = 22.5
+#: Held noisy poses nearer than this (degrees) to the part's last written
+#: pose are that pose: about twice a fitted limb's direction error (3-6°).
+_SAME_POSE_DEG = 10.0
 #: Longest hold after a noisy arrival over which the pose is averaged, seconds.
 _HOLD_S = 0.4
 
@@ -393,29 +400,28 @@ def segment(joints: np.ndarray, fps: float, tempo=None, meter: int = 4, params: 
 
 
 def _label_at(labels: FrameLabels, col: int, frames: slice) -> tuple[str, str, int]:
-    """Label of a gesture column from its mean vector over `frames` (robust to jitter)."""
+    """Label of a gesture column from its median pose over `frames` (robust to jitter and flicker)."""
     from ..notation.directions import bend_degree, classify_indices
 
-    v = np.nanmean(labels.vectors[frames, col], axis=0)
+    v, bd = held_pose(labels.vectors[:, col], labels.bend_deg[:, col], frames)
     d, lv = classify_indices(v[None])
     if d[0] < 0:
         return "", "", -1
-    bd = labels.bend_deg[frames, col]
-    bend = int(bend_degree(np.nanmean(bd))) if np.isfinite(bd).any() else 0
+    bend = int(bend_degree(bd)) if np.isfinite(bd) else 0
     return DIRECTION_NAMES[d[0]], LEVELS[lv[0]], bend
 
 
 def _tilt_deg(labels: FrameLabels, col: int, frames: slice) -> float:
-    """Angle of a column's mean vector over `frames` from vertical, degrees."""
-    v = np.nanmean(labels.vectors[frames, col], axis=0)
+    """Angle of a column's median vector over `frames` from vertical, degrees."""
+    v, _ = held_pose(labels.vectors[:, col], None, frames)
     return float(np.degrees(np.arccos(np.clip(v[2] / np.linalg.norm(v), -1.0, 1.0))))
 
 
 def _off_canonical_deg(labels: FrameLabels, col: int, frames: slice) -> float:
-    """Angle from the mean vector of a column to its label's canonical vector, degrees."""
+    """Angle from the median vector of a column to its label's canonical vector, degrees."""
     from ..notation.directions import canonical_vector
 
-    v = np.nanmean(labels.vectors[frames, col], axis=0)
+    v, _ = held_pose(labels.vectors[:, col], None, frames)
     d, lv, _ = _label_at(labels, col, frames)
     if not d or (d == "place" and lv == "middle"):
         return float("inf")
@@ -649,6 +655,8 @@ def _gesture_movements(
         near = None if clean else _off_canonical_series(u_list[0]) < _NEAR_POSE_DEG
         spans = movement_spans(speed, low, high, params.split_ratio, key_pose=key, near_pose=near)
         state = _DEFAULT.get(part, ("place", "low")) + (0,)
+        # Noisy motion: the held pose of the part's last written symbol.
+        last_pose = None
         for i, (a, b) in enumerate(spans):
             start_f, end_f = a, min(b + 1, T - 1)
             nxt = spans[i + 1][0] if i + 1 < len(spans) else T
@@ -672,7 +680,7 @@ def _gesture_movements(
                     # (half a beat at 96 bpm is fitted as quick as 0.17 s).
                     continue
                 end_f = min(max(int(round(t1 * fps)), start_f + 1), T - 1)
-                frames = slice(end_f, max(end_f + 1, min(end_f + hold, nxt + 1)))
+                frames = hold_frames(end_f, b + 1, nxt, hold, T)
             if arrivals is not None and arrivals[end_f] and not _key_pose_fn(labels, part)(end_f, start_f):
                 # Clean motion: a free leg that arrives with the weight and on
                 # no written pose was carried by the weight transfer (a foot
@@ -696,11 +704,43 @@ def _gesture_movements(
                 if margin and _tilt_deg(labels, whole, frames) < _TILT_DEG + margin:
                     # Within the fit's own trunk noise of upright.
                     d, lv = _DEFAULT[part]
+            if not clean:
+                pose = held_pose(labels.vectors[:, whole], labels.bend_deg[:, whole] if part in _LIMBS else None, frames)
+                if _same_pose(pose, last_pose, state, params):
+                    # Arrived within the fit's error of the last written pose:
+                    # a label change would only be a boundary crossed by it.
+                    continue
+                if part in _LIMBS or not margin:
+                    d, lv, bend = keep_previous(pose[0], pose[1], (d, lv, bend), state)
             if (d, lv, bend) == state:
                 continue
             state = (d, lv, bend)
+            last_pose = None if clean else pose
             out.append(Movement(part, start_f, end_f, t0, t1, d, lv, bend))
     return out
+
+
+def _same_pose(pose: tuple, last: tuple | None, state: tuple, params: SegmentParams) -> bool:
+    """Whether a measured held `pose` ``(v, β)`` is the part's last written pose within the fit's error.
+
+    `last` is the held pose of the last written symbol, or None: then the
+    state's canonical pose (the starting pose) stands in, with its bend.
+    Directions closer than ``min_amplitude_deg`` and bends within half a
+    bend step are one pose (DESIGN.md's bend degrees are 30° apart).
+    """
+    from ..notation.directions import BEND_STEP_DEG, canonical_vector
+
+    v, bend = pose
+    if last is None:
+        d, lv, k = state
+        if not d or (d == "place" and lv == "middle"):
+            return False
+        last = (canonical_vector(d, lv), BEND_STEP_DEG * k)
+    if not (np.isfinite(v).all() and np.isfinite(last[0]).all()):
+        return False
+    if float(_angle_deg(v, last[0])) >= _SAME_POSE_DEG:
+        return False
+    return not (np.isfinite(bend) and np.isfinite(last[1]) and abs(bend - last[1]) >= BEND_STEP_DEG / 2)
 
 
 def _progress_window(u_list: list, x_list: list, spans: list, i: int, fps: float):

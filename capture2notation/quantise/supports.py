@@ -354,7 +354,29 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         state = new
         out.append(Movement(_SUPPORT_PARTS[new_part], start, end, max(t0, 0.0), t1, direction, LEVELS[new_level], 0))
         prev_start, prev_end = a, b
-    return _join_flights(out, smooth)
+    return _drop_unheld(_join_flights(out, smooth))
+
+
+def _drop_unheld(moves: list) -> list:
+    """Noisy support movements without an excursion that was left before it was reached.
+
+    A weight shift (a ``place`` support) that the next support movement
+    starts before it arrives (their fitted logistics overlap), that next one
+    returning to the state before it, never held its state: the fit swayed
+    there and back — typically in the first frames of a clip, while the
+    smoothed feet settle on the floor.  Both are dropped.  A shift followed
+    by a different state (a step, a closing after a step) is kept.
+    """
+    out: list = []
+    for m in moves:
+        prev = out[-1] if out else None
+        if prev is not None and m.start_time < prev.end_time and prev.direction == "place" == m.direction:
+            before = (out[-2].part, out[-2].level) if len(out) > 1 else ("support", "middle")
+            if (m.part, m.level) == before:
+                out.pop()
+                continue
+        out.append(m)
+    return out
 
 
 #: A weight transfer onto one foot that the other foot's step follows
