@@ -261,7 +261,8 @@ def estimate_effort(joints, confidence, fps: float, score: Score, kept: np.ndarr
 
     from capture2notation.effort import TIME_RANGE, WEIGHT_RANGE, progress
     from capture2notation.effort.curves import progress_curve
-    from capture2notation.effort.fit import fit_logistic, fit_space
+    from capture2notation.effort.fit import fit_logistic
+    from capture2notation.effort.pooled import pool_curves, pooled_space
 
     times = kept / fps
     curves = []
@@ -279,18 +280,12 @@ def estimate_effort(joints, confidence, fps: float, score: Score, kept: np.ndarr
         return {"time": nan3, "weight": nan3, "space": nan3, "movements": len(curves)}
 
     def pooled(sel):
-        return tuple(np.concatenate([getattr(curves[i], k) for i in sel]) for k in ("tau", "s", "weight"))
+        return pool_curves([curves[i] for i in sel])[:3]
 
     def space(sel):
-        # Only whole limbs show Space (a head keeps its radius); each pooled
-        # movement keeps its own straight-line trend (capture2notation.effort).
-        sel = [i for i in sel if curves[i].shows_space]
-        if not sel:
-            return np.nan
-        tau, rad, w, out = (np.concatenate([getattr(curves[i], k) for i in sel])
-                            for k in ("tau", "radial", "weight", "outward"))
-        groups = np.concatenate([np.full(len(curves[i].tau), g) for g, i in enumerate(sel)])
-        return fit_space(tau, rad, w, outward=out, groups=groups).median
+        # capture2notation.effort's own pooling: whole limbs only, a trend per movement.
+        chosen = [curves[i] for i in sel if curves[i].shows_space]
+        return pooled_space(chosen).median if chosen else np.nan
 
     tau, s, w = pooled(np.arange(len(curves)))
     lf = fit_logistic(tau, s, w)
