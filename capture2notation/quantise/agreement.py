@@ -37,6 +37,7 @@ from fractions import Fraction
 import numpy as np
 
 from ..errors import CompareError
+from ..notation.directions import canonical_vector, classify
 from ..notation.model import GESTURE_PARTS, Score, Symbol
 
 __all__ = [
@@ -161,6 +162,12 @@ def at_tempo(score: Score, tempo) -> Score:
 def state_at(score: Score, part: str, beats) -> list[tuple]:
     """Destination (direction, level) written for `part` at each beat.
 
+    A limb and its two segments describe one body part, so their states
+    follow each other: a whole-limb symbol also places both segments (each
+    points the limb's way), and a segment symbol also moves the whole limb,
+    whose direction is then that of shoulder → wrist (hip → ankle) with the
+    two segments at their canonical vectors and the body model's lengths.
+
     Parameters
     ----------
     score : Score
@@ -180,21 +187,69 @@ def state_at(score: Score, part: str, beats) -> list[tuple]:
         syms = [s for s in score.symbols if s.is_support]
         cur = DEFAULT_SUPPORT
     else:
-        syms = [s for s in score.symbols if s.part == part]
+        family = _FAMILY.get(part, (part,))
+        syms = [s for s in score.symbols if s.part in family]
         cur = DEFAULT_STATE[part][:2]
+        segs = {p: DEFAULT_STATE[p][:2] for p in family[1:]}
     out, i = [], 0
     for b in beats:
         while i < len(syms) and syms[i].start <= b:
             s = syms[i]
-            cur = (s.part, s.direction, s.level) if part == "supports" else (s.direction, s.level)
             i += 1
+            if part == "supports":
+                cur = (s.part, s.direction, s.level)
+            elif s.part == family[0]:
+                cur = (s.direction, s.level)
+                segs = dict.fromkeys(segs, cur)
+            else:
+                segs[s.part] = (s.direction, s.level)
+                cur = segs[part] if part in segs else _limb_state(part, segs)
         out.append(cur)
     return out
 
 
+def _limb_state(limb: str, segs: dict) -> tuple[str, str]:
+    """(direction, level) of a whole limb whose segments point as `segs` says."""
+    up, low = _SEGMENTS[limb]
+    v = sum(_LENGTHS[limb][k] * canonical_vector(*segs[p]) for k, p in enumerate((up, low)))
+    return classify(v)
+
+
+def _family() -> dict[str, tuple[str, ...]]:
+    """Parts whose symbols set each part's state: the part first, then the rest of its limb."""
+    fam = {}
+    for limb, (up, low) in _SEGMENTS.items():
+        fam[limb] = (limb, up, low)
+        fam[up] = (limb, up)
+        fam[low] = (limb, low)
+    return fam
+
+
+def _limb_lengths() -> dict[str, tuple[float, float]]:
+    from ..body import Body, joint_index
+
+    lengths = np.linalg.norm(Body().offsets, axis=1)
+    ends = {"arm": ("elbow", "wrist"), "leg": ("knee", "ankle")}
+    return {f"{side}_{limb}": tuple(float(lengths[joint_index(f"{side}_{j}")]) for j in ends[limb])
+            for side in ("right", "left") for limb in ends}
+
+
+_FAMILY = _family()
+_LENGTHS = _limb_lengths()
+
+
 def _parts(ref: Score, cand: Score) -> list[str]:
-    used = {s.part for s in ref.symbols} | {s.part for s in cand.symbols}
-    parts = [p for p in DEFAULT_STATE if p in used]
+    """Columns compared: every part either score moves, a limb's segments
+    only where the reference writes them (a captured segment symbol is
+    judged by where it takes its whole limb, not counted twice)."""
+    written = {s.part for s in ref.symbols}
+    columns = set()
+    for part in written | {s.part for s in cand.symbols}:
+        limb = _FAMILY.get(part, (part,))[0]
+        columns.add(limb)
+        if part in written:
+            columns.add(part)
+    parts = [p for p in DEFAULT_STATE if p in columns]
     if any(s.is_support for s in ref.symbols + cand.symbols):
         parts.append("supports")
     return parts
@@ -203,7 +258,9 @@ def _parts(ref: Score, cand: Score) -> list[str]:
 def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> float:
     """Fraction of (part, beat) cells where both scores write the same direction and level.
 
-    Each cell is sampled at its centre, so timing errors under half a step
+    The columns are the parts either score moves (a limb's segments only
+    when the reference writes them: a captured forearm symbol counts through
+    its whole arm, :func:`state_at`).  Each cell is sampled at its centre, so timing errors under half a step
     cost nothing here (see :func:`start_errors` for them).
 
     Parameters

@@ -17,6 +17,7 @@ from capture2notation.quantise.agreement import (
     normalise,
     score_differences,
     start_errors,
+    state_at,
     symbol_agreement,
 )
 
@@ -55,6 +56,37 @@ def test_normal_form_drops_no_ops():
 def test_identical_scores_agree_fully():
     a = compare_scores(REF, REF)
     assert a.symbol_agreement == 1.0 and a.exact and a.unmatched == 0 and a.median_start_error == 0.0
+
+
+def test_limb_and_segment_states_follow_each_other():
+    # A bent knee at beat 1, then the straight whole leg at beat 2: from beat 2
+    # the shin points the leg's way again, and the leg's own state at beat 1
+    # is the direction of hip → ankle with the shin bent back.
+    score = normalise(Score(
+        symbols=(
+            Symbol(0, 1, "right_leg", "right", "low"),
+            Symbol(1, 1, "right_shin", "back", "low"),
+            Symbol(2, 1, "right_leg", "forward", "low"),
+        ),
+        tempo=60,
+    ))
+    beats = [F(1, 2), F(3, 2), F(5, 2)]
+    assert state_at(score, "right_shin", beats) == [("right", "low"), ("back", "low"), ("forward", "low")]
+    assert state_at(score, "right_thigh", beats) == [("right", "low")] * 2 + [("forward", "low")]
+    assert state_at(score, "right_leg", beats) == [("right", "low"), ("right_back", "low"), ("forward", "low")]
+    # The same movement written as segments or as the whole straight limb agrees.
+    split = Score(symbols=(Symbol(0, 1, "right_thigh", "right", "low"), Symbol(0, 1, "right_shin", "right", "low"),
+                           Symbol(1, 1, "right_upper_arm", "forward", "middle"),
+                           Symbol(1, 1, "right_forearm", "forward", "middle")), tempo=60)
+    whole = Score(symbols=(Symbol(0, 1, "right_leg", "right", "low"), Symbol(1, 1, "right_arm", "forward", "middle")),
+                  tempo=60)
+    assert symbol_agreement(whole, split) == 1.0
+    # A stray forearm symbol is one wrong arm cell per beat, not an arm and a forearm column.
+    ref = whole.replace(symbols=whole.symbols + (Symbol(2, 1, "right_leg", "place", "low"),))
+    stray = ref.replace(symbols=ref.symbols + (Symbol(2, 1, "right_forearm", "place", "high"),))
+    # Columns right_arm, right_leg over beats 0..2: the forearm raised to
+    # the vertical takes the arm forward high at beat 2 instead of forward middle.
+    assert symbol_agreement(ref, stray) == pytest.approx(5 / 6)
 
 
 def test_shifted_symbol_costs_one_beat_cell_and_its_start_error():
