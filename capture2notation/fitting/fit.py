@@ -258,12 +258,17 @@ def _direction_terms(names, tc, tw):
 def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body, floor: bool = False) -> np.ndarray:
     """Per-clip proportions from the image lengths of the segments.
 
-    A segment's image length, turned into metres at its depth, is its true
-    length when it lies parallel to the image.  With world landmarks, the
-    frames where they say so (depth component under 0.25 of the length) give
-    the median length, at the segment's own depth (pelvis depth + landmark
-    depth); without, the 90th percentile over the clip does.  Only the
-    proportions are kept (``relative=True`` in
+    A segment's two ends put back on their pixels' rays at their depths
+    (pelvis depth + world landmark depth, :func:`_backprojected_lengths`)
+    are its length apart when those depths are right, and its length
+    foreshortened when the landmarks flatten it.  With world landmarks, the
+    frames where they call the segment flat (depth component under 0.25 of
+    the length) give the median length; without, the 90th percentile over
+    the clip does.  The upper arms take the long end of all their frames
+    instead (:func:`_upper_arm_length`: the landmarks call many a
+    foreshortened arm flat, which measured them 10-15 % short on our
+    renders) and the forearms their proportion to it; neither sets the
+    figure's scale.  Only the proportions are kept (``relative=True`` in
     :func:`~capture2notation.fitting.lengths.offsets_from_ratios`), so the
     lengths agree with where the keypoint model puts its landmarks (a BlazePose
     ankle sits above our ankle joint) while the size stays the body's.
@@ -277,18 +282,68 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body, floor: bool = 
         if p < 0 or name not in names or JOINTS[p] not in names or base[j] <= 0:
             continue
         a, b = names.index(JOINTS[p]), names.index(name)
-        ok = (tc[:, a] >= 0.5) & (tc[:, b] >= 0.5)
-        z = depth
+        metres = _backprojected_lengths(camera, tx, tw, depth, a, b)
+        ok = (tc[:, a] >= 0.5) & (tc[:, b] >= 0.5) & np.isfinite(metres)
         if tw is not None:
             d = tw[:, b] - tw[:, a]
-            flat = np.abs(d[:, 2]) < 0.25 * np.linalg.norm(d, axis=1)
-            z = depth + 0.5 * (tw[:, a, 2] + tw[:, b, 2])
-            ok &= flat & np.isfinite(z)
+            ok &= np.abs(d[:, 2]) < 0.25 * np.linalg.norm(d, axis=1)
         if ok.sum() < 3:
             continue
-        metres = np.linalg.norm(tx[ok, b] - tx[ok, a], axis=1) * z[ok] / camera.focal
-        ratio[j] = (np.median(metres) if tw is not None else np.percentile(metres, 90)) / base[j]
-    return offsets_from_ratios(ratio, body, relative=True)
+        ratio[j] = (np.median(metres[ok]) if tw is not None else np.percentile(metres[ok], 90)) / base[j]
+    scale_from = np.isfinite(ratio)
+    for side in ("right", "left"):
+        upper = _upper_arm_length(camera, tx, tc, tw, depth, names.index(f"{side}_shoulder"),
+                                  names.index(f"{side}_elbow"))
+        elbow, wrist = JOINTS.index(f"{side}_elbow"), JOINTS.index(f"{side}_wrist")
+        if np.isfinite(upper):
+            ratio[elbow] = np.nanmax([ratio[elbow], upper / base[elbow]])
+        # The image model's wrist slides along the hand with the pose (up the
+        # hand of a hanging arm, out along an extended one): the forearm keeps
+        # the body's proportion to the upper arm.
+        ratio[wrist] = ratio[elbow]
+        scale_from[[elbow, wrist]] = False
+    return offsets_from_ratios(ratio, body, relative=True, scale_from=scale_from)
+
+
+def _upper_arm_length(camera: Camera, tx, tc, tw, depth, a: int, b: int) -> float:
+    """Length of an upper arm (metres) from the long end of its back-projected lengths.
+
+    Each end is put back on its pixel's ray at the pelvis depth plus its
+    world landmark's depth (the pelvis depth alone without landmarks).  The
+    landmarks' depth differences are too small on a foreshortened arm (and
+    call it flat), which only shortens this length, so the long end of it —
+    the 90th percentile less what the keypoints' jitter adds to it — is the
+    arm seen side on.  NaN with fewer than 3 confident frames.
+    """
+    length = _backprojected_lengths(camera, tx, tw, depth, a, b)
+    ok = (tc[:, a] >= 0.5) & (tc[:, b] >= 0.5) & np.isfinite(length)
+    if ok.sum() < 3:
+        return float("nan")
+    return float(np.percentile(length[ok], 90) - 1.28 * _jitter(np.where(ok, length, np.nan)))
+
+
+def _backprojected_lengths(camera: Camera, tx, tw, depth, a: int, b: int) -> np.ndarray:
+    """(T,) distance (metres) between targets `a` and `b` put back on their pixels' rays.
+
+    Each at the pelvis depth `depth` plus its world landmark's depth, or at
+    the pelvis depth alone without world landmarks.
+    """
+    za, zb = (depth, depth) if tw is None else (depth + tw[:, a, 2], depth + tw[:, b, 2])
+    return np.linalg.norm(camera.backproject(tx[:, a], za) - camera.backproject(tx[:, b], zb), axis=-1)
+
+
+def _jitter(x: np.ndarray) -> float:
+    """Standard deviation of the frame-to-frame noise of a smooth series (NaN-tolerant).
+
+    From second differences, which a motion smooth at the frame rate hardly
+    moves: white noise of spread s spreads them by s·√6.  The median
+    absolute deviation keeps a fast movement's few large steps out.
+    """
+    d2 = np.diff(np.asarray(x, float), n=2)
+    d2 = d2[np.isfinite(d2)]
+    if d2.size < 3:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
 
 
 def _floor_start_depth(model: PoseModel, cam: Camera, names, tx, tc, tw, size_depth, rest) -> np.ndarray:

@@ -75,7 +75,8 @@ def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | No
     return offsets_from_ratios(ratio, body, relative)
 
 
-def offsets_from_ratios(ratio: np.ndarray, body: Body | None = None, relative: bool = False) -> np.ndarray:
+def offsets_from_ratios(ratio: np.ndarray, body: Body | None = None, relative: bool = False,
+                        scale_from: np.ndarray | None = None) -> np.ndarray:
     """Offsets from measured length ratios to the model (NaN = not measured).
 
     Parameters
@@ -85,6 +86,9 @@ def offsets_from_ratios(ratio: np.ndarray, body: Body | None = None, relative: b
     body : Body, optional
     relative : bool
         See :func:`estimate_offsets`.
+    scale_from : (J,) ndarray of bool, optional
+        Segments whose ratios set the figure's overall scale (their median);
+        all measured ones by default.  The others are still scaled by it.
 
     Returns
     -------
@@ -94,7 +98,7 @@ def offsets_from_ratios(ratio: np.ndarray, body: Body | None = None, relative: b
     ratio = np.asarray(ratio, float).copy()
     ratio[~((ratio >= _RATIO_BAND[0]) & (ratio <= _RATIO_BAND[1]))] = np.nan
     ratio = _symmetrise(ratio)
-    measured = ratio[np.isfinite(ratio)]
+    measured = ratio[np.isfinite(ratio) & (True if scale_from is None else np.asarray(scale_from, bool))]
     overall = float(np.median(measured)) if measured.size else 1.0
     ratio = np.where(np.isfinite(ratio), ratio, overall)
     if relative:

@@ -56,6 +56,26 @@ def test_noisy_keypoints_stay_within_a_few_degrees(scene, synth):
     assert np.median(synth.limb_direction_errors(res.joints, truth)) < 5.0
 
 
+def test_upper_arm_length_comes_from_its_side_on_frames(synth):
+    # Arms to the side for a third of the clip, then forward low (towards the
+    # camera, 45° down); the world landmarks keep a fifth of the arms' depth
+    # (BlazePose's follow it with a slope of 0.1-0.4), so they call the
+    # forward arms "flat", and their image lengths are 0.7 of the arm's.
+    body = Body()
+    side, _ = synth.held_pose(15, body, right_shoulder=(0.0, -1.57, 0.0), left_shoulder=(0.0, 1.57, 0.0))
+    ahead, root = synth.held_pose(30, body, right_shoulder=(0.785, 0.0, 0.0), left_shoulder=(0.785, 0.0, 0.0))
+    ang, root = np.concatenate([side, ahead]), np.concatenate([root[:15], root])
+    cam = Camera.default((640, 480))
+    xy, conf, world, truth = synth.observe(ang, root, cam, body)
+    for shoulder, arm in ((12, [14, 16, 18, 20, 22]), (11, [13, 15, 17, 19, 21])):
+        world[:, arm, 2] = world[:, [shoulder], 2] + 0.2 * (world[:, arm, 2] - world[:, [shoulder], 2])
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    upper = np.linalg.norm(res.offsets[joint_index("right_elbow")])
+    assert upper == pytest.approx(np.linalg.norm(body.offsets[joint_index("right_elbow")]), rel=0.03)
+    # The forward arms are fitted so.
+    assert np.median(synth.limb_direction_errors(res.joints[15:], truth[15:])) < 5.0
+
+
 def test_joint_limits_hold(scene, synth):
     body, ang, root, cam = scene
     xy, conf, world, _ = synth.observe(ang, root, cam, body, noise_px=8.0, seed=4)

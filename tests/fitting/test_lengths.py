@@ -47,3 +47,21 @@ def test_nan_points_are_ignored_and_bad_shapes_rejected():
     np.testing.assert_allclose(off, body.offsets, atol=1e-9)
     with pytest.raises(FittingError, match="points"):
         estimate_offsets(pts[:, :5], np.ones((10, 5)))
+
+
+def test_segments_left_out_of_the_scale_do_not_move_the_others():
+    from capture2notation.fitting.lengths import offsets_from_ratios
+
+    body = Body()
+    ratio = np.full(len(JOINTS), 1.0)
+    ratio[0] = np.nan
+    arms = [joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("elbow", "wrist")]
+    long_arms = ratio.copy()
+    long_arms[arms] = 1.1
+    keep = np.ones(len(JOINTS), bool)
+    keep[arms] = False
+    base = np.linalg.norm(offsets_from_ratios(ratio, body, relative=True), axis=1)
+    out = np.linalg.norm(offsets_from_ratios(long_arms, body, relative=True, scale_from=keep), axis=1)
+    others = np.setdiff1d(np.arange(1, len(JOINTS)), arms)
+    np.testing.assert_allclose(out[others], base[others], rtol=1e-12)
+    np.testing.assert_allclose(out[arms], 1.1 * base[arms], rtol=1e-12)
