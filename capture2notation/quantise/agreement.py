@@ -260,8 +260,9 @@ def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> f
 
     The columns are the parts either score moves (a limb's segments only
     when the reference writes them: a captured forearm symbol counts through
-    its whole arm, :func:`state_at`).  Each cell is sampled at its centre, so timing errors under half a step
-    cost nothing here (see :func:`start_errors` for them).
+    its whole arm, :func:`state_at`).  Each cell is sampled at its centre,
+    so timing errors under half a step cost nothing here (see
+    :func:`start_errors` for them).
 
     Parameters
     ----------
