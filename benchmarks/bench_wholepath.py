@@ -1,6 +1,6 @@
 """The whole path on phrases kept out of development: accuracy and speed.
 
-Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phrases DIR]``.
+Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phrases DIR] [--explain]``.
 
 Each phrase (``benchmarks/holdout/*.lab`` by default: eight phrases of arms,
 legs and supports written for this measurement and never used to tune the
@@ -15,6 +15,9 @@ Printed (never asserted): per phrase and overall, the symbol agreement
 (direction + level per part per beat of the original), the median start-time
 error in beats, whether the truth capture is exact, the median limb-direction
 error and MPJPE of the fit, and frames per second of the whole video capture.
+With ``--explain``, under each phrase, the beats it loses: per part, the
+reference's state and the capture's
+(:func:`capture2notation.quantise.agreement.agreement_cells`).
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
     from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
     from capture2notation.notation.formats import read
-    from capture2notation.quantise.agreement import compare_scores
+    from capture2notation.quantise.agreement import agreement_cells, compare_scores
     from pipelines.capture import capture
     from pipelines.commands.demo import _limb_error
     from synthetic.render import render_score
@@ -64,7 +67,16 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
         "mpjpe_cm": 100 * float(np.nanmean(mpjpe(np.asarray(truth.joints), np.asarray(video.motion.joints)))),
         "fps": truth.n_frames / seconds,
         "frames": truth.n_frames,
+        "missed": [c for c in agreement_cells(score, video.score) if c.ref != c.cand],
     }
+
+
+def _explain(missed) -> str:
+    """The lost cells, one line per part: ``beat: written -> captured`` (beats from 0)."""
+    lines = {}
+    for c in missed:
+        lines.setdefault(c.part, []).append(f"{float(c.beat) - 0.5:g}: {' '.join(c.ref)} -> {' '.join(c.cand)}")
+    return "".join(f"    {part:<16} " + "; ".join(v) + "\n" for part, v in lines.items())
 
 
 def main() -> None:
@@ -73,6 +85,7 @@ def main() -> None:
     ap.add_argument("--phrases", type=Path, default=HOLDOUT, help="folder of .lab phrases")
     ap.add_argument("--effort", action="store_true", help="include the Effort estimate in the timed capture")
     ap.add_argument("--tempo-given", action="store_true", help="give the video capture the written tempo")
+    ap.add_argument("--explain", action="store_true", help="list the beats each phrase loses")
     ap.add_argument("--flip-test", action=argparse.BooleanOptionalAction, default=None,
                     help="BlazePose's mirrored second pass (default: capture's default)")
     args = ap.parse_args()
@@ -85,6 +98,8 @@ def main() -> None:
             print(f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
                   f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
                   f"limb {r['limb_deg']:4.1f}°  MPJPE {r['mpjpe_cm']:4.1f} cm  {r['fps']:5.1f} fps", flush=True)
+            if args.explain:
+                print(_explain(r["missed"]), end="", flush=True)
     frames = sum(r["frames"] for r in rows)
     weights = np.array([r["frames"] for r in rows], float)
     how = "given" if args.tempo_given else "estimated"

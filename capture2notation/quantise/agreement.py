@@ -43,6 +43,8 @@ from ..notation.model import GESTURE_PARTS, Score, Symbol
 __all__ = [
     "DEFAULT_STATE",
     "Agreement",
+    "Cell",
+    "agreement_cells",
     "at_tempo",
     "normalise",
     "state_at",
@@ -255,6 +257,52 @@ def _parts(ref: Score, cand: Score) -> list[str]:
     return parts
 
 
+@dataclass(frozen=True)
+class Cell:
+    """One (part, beat) cell of :func:`agreement_cells`.
+
+    Attributes
+    ----------
+    part : str
+        Column: a gesture part or ``"supports"``.
+    beat : Fraction
+        Sample time (the cell's centre), reference beats.
+    ref, cand : tuple
+        State written there by each score (see :func:`state_at`).
+    """
+
+    part: str
+    beat: Fraction
+    ref: tuple
+    cand: tuple
+
+
+def agreement_cells(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> list[Cell]:
+    """Every cell :func:`symbol_agreement` compares, with both scores' states.
+
+    Parameters
+    ----------
+    ref, cand : Score
+        As for :func:`symbol_agreement`.
+    step : Fraction
+        Sampling step in reference beats.
+
+    Returns
+    -------
+    list of Cell
+        Column by column, in time order; the cells where ``ref != cand``
+        are what the agreement misses.
+    """
+    ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
+    end = max(ref.duration, cand.duration)
+    n = int(np.ceil(end / step)) if end > 0 else 0
+    # Cell centres: a symbol starting a frame late (or a tempo a bpm off)
+    # does not lose its whole cell; start errors are reported on their own.
+    beats = [(k + Fraction(1, 2)) * step for k in range(n)]
+    return [Cell(p, b, x, y) for p in _parts(ref, cand)
+            for b, x, y in zip(beats, state_at(ref, p, beats), state_at(cand, p, beats))]
+
+
 def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> float:
     """Fraction of (part, beat) cells where both scores write the same direction and level.
 
@@ -277,21 +325,10 @@ def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> f
     float
         In [0, 1]; 1.0 when neither score writes anything.
     """
-    ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
-    parts = _parts(ref, cand)
-    end = max(ref.duration, cand.duration)
-    n = int(np.ceil(end / step)) if end > 0 else 0
-    if not parts or n == 0:
+    cells = agreement_cells(ref, cand, step)
+    if not cells:
         return 1.0
-    # Cell centres: a symbol starting a frame late (or a tempo a bpm off)
-    # does not lose its whole cell; start errors are reported on their own.
-    beats = [(k + Fraction(1, 2)) * step for k in range(n)]
-    same = total = 0
-    for p in parts:
-        a, b = state_at(ref, p, beats), state_at(cand, p, beats)
-        same += sum(x == y for x, y in zip(a, b))
-        total += n
-    return same / total
+    return sum(c.ref == c.cand for c in cells) / len(cells)
 
 
 def start_errors(ref: Score, cand: Score) -> tuple[np.ndarray, int]:

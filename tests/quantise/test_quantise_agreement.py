@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from capture2notation.errors import CompareError
 from capture2notation.notation.model import Score, Symbol
 from capture2notation.quantise.agreement import (
+    agreement_cells,
     at_tempo,
     compare_scores,
     normalise,
@@ -56,6 +57,17 @@ def test_normal_form_drops_no_ops():
 def test_identical_scores_agree_fully():
     a = compare_scores(REF, REF)
     assert a.symbol_agreement == 1.0 and a.exact and a.unmatched == 0 and a.median_start_error == 0.0
+
+
+def test_agreement_cells_name_what_the_agreement_misses():
+    cand = Score(symbols=(Symbol(1, 1, "right_arm", "forward", "middle"),
+                          Symbol(2, 2, "right_arm", "right", "middle", bend=1),
+                          Symbol(1, 2, "head", "forward", "high")), tempo=60)
+    cells = agreement_cells(REF, cand)
+    wrong = [(c.part, c.beat, c.ref, c.cand) for c in cells if c.ref != c.cand]
+    assert wrong == [("right_arm", F(5, 2), ("right", "high"), ("right", "middle")),
+                     ("right_arm", F(7, 2), ("right", "high"), ("right", "middle"))]
+    assert symbol_agreement(REF, cand) == pytest.approx(1 - len(wrong) / len(cells))
 
 
 def test_limb_and_segment_states_follow_each_other():
