@@ -80,3 +80,40 @@ def test_a_bent_elbow_tells_the_forearm_side_when_world_depth_says_nothing(synth
     off = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world, options=FitOptions(depth=None))
     fore_off = CAM.to_camera(off.joints[:, joint_index("right_wrist")]) - CAM.to_camera(off.joints[:, joint_index("right_elbow")])
     assert np.mean(-fore_off[:, 2] / np.linalg.norm(fore_off, axis=1)) < np.mean(towards)
+
+
+def _with_rest_offset(world, up=0.23, fore=-0.22):
+    """BlazePose-like world landmarks: right elbow `up` upper arms behind the
+    shoulder, wrist `fore` forearms behind the elbow, in every pose."""
+    out = world.copy()
+    body = Body()
+    lu = np.linalg.norm(body.offsets[joint_index("right_elbow")])
+    lf = np.linalg.norm(body.offsets[joint_index("right_wrist")])
+    out[:, [14, 16, 18, 20, 22], 2] += up * lu
+    out[:, [16, 18, 20, 22], 2] += fore * lf
+    return out
+
+
+def test_the_world_landmarks_rest_offset_is_measured_on_the_hanging_arm_and_removed(synth):
+    # The arm hangs for 12 frames (DESIGN.md's starting pose), then rises
+    # forward low.  The world landmarks keep half of the depth and put the
+    # elbow 0.4 of the upper arm behind the shoulder in every pose (BlazePose
+    # on our renders: a quarter, with less of the depth): read as they come
+    # they put the raised upper arm behind too.
+    body = Body()
+    rest, _ = synth.held_pose(12, body)
+    ahead, root = synth.held_pose(T, body, right_shoulder=(0.785, 0.0, 0.0))
+    ang, root = np.concatenate([rest, ahead]), np.concatenate([root[:12], root])
+    xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=5)
+    world[:, [14, 16, 18, 20, 22], 2] = world[:, [12], 2] + 0.5 * (world[:, [14, 16, 18, 20, 22], 2] - world[:, [12], 2])
+    world = _with_rest_offset(world, up=0.4, fore=-0.4)
+    assert np.all(_depth_sign(truth[12:], "right_shoulder", "right_elbow") < 0)
+
+    def towards(options):
+        res = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world, options=options)
+        return np.mean(_depth_sign(res.joints[12:], "right_shoulder", "right_elbow") < 0)
+
+    from capture2notation.fitting.depth import DepthOptions
+
+    assert towards(FitOptions()) >= 0.9
+    assert towards(FitOptions(depth=DepthOptions(rest_offset=False))) <= 0.1  # measured: behind
