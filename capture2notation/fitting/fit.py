@@ -33,7 +33,7 @@ import numpy as np
 from ..body import JOINTS, Body, joint_index
 from ..errors import FittingError
 from .camera import DEFAULT_HFOV_DEG, Camera
-from .depth import choose_arm_depths
+from .depth import DepthOptions, choose_arm_depths, remove_leg_rest_offsets
 from .floor import FLOOR_POINTS, floor_depth, support_depth
 from .ik import initial_angles
 from .lengths import offsets_from_ratios
@@ -618,6 +618,8 @@ def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, worl
             # before the continuous solve, which only refines the side it
             # starts on.
             tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth)
+            if opt.depth.rest_offset:
+                tw = remove_leg_rest_offsets(model, camera, params0, names, tx, tc, tw)
         _, terms.dirs, terms.wd = _direction_terms(names, tc, tw)
         params0 = _initial_params(model, camera, names, tx, tc, tw, floor=known)
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
@@ -776,7 +778,9 @@ def fit_track(track, camera: Camera | None = None, body: Body | None = None,
     camera : Camera, optional
         Known camera; default a :meth:`Camera.default` refined from the data.
     body, options : optional
-        Passed to :func:`fit_keypoints`.
+        Passed to :func:`fit_keypoints`.  Without `options`, a BlazePose
+        track has its world landmarks' rest offset removed
+        (``DepthOptions(rest_offset=True)``).
     """
     xy = np.asarray(track.xy, float)
     vis = np.asarray(track.visibility, float)
@@ -788,6 +792,10 @@ def fit_track(track, camera: Camera | None = None, body: Body | None = None,
         world = np.asarray(world, float)
         if not np.any(np.isfinite(world)):
             world = None
+    if options is None and getattr(track, "backend", None) == "blazepose":
+        # BlazePose's world landmarks give a straight hanging limb a depth
+        # of its own (:mod:`~capture2notation.fitting.depth`).
+        options = FitOptions(depth=DepthOptions(rest_offset=True))
     return fit_keypoints(xy, vis, float(track.fps), camera=camera, world=world, body=body,
                          times=getattr(track, "times", None), image_size=tuple(np.asarray(track.image_size).tolist()),
                          options=options)
