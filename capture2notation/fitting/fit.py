@@ -313,9 +313,14 @@ def _upper_arm_length(camera: Camera, tx, tc, tw, depth, a: int, b: int) -> floa
     landmarks' depth differences are too small on a foreshortened arm (and
     call it flat), which only shortens this length, so the long end of it —
     the 90th percentile less what the keypoints' jitter adds to it — is the
-    arm seen side on.  NaN with fewer than 3 confident frames.
+    arm seen side on.  The landmarks' depth noise lengthens every frame
+    (by its variance, in quadrature), which is taken out first.  NaN with
+    fewer than 3 confident frames.
     """
     length = _backprojected_lengths(camera, tx, tw, depth, a, b)
+    if tw is not None:
+        dz = np.where(np.isfinite(length), tw[:, b, 2] - tw[:, a, 2], np.nan)
+        length = np.sqrt(np.maximum(length**2 - _jitter(dz) ** 2, 0.0))
     ok = (tc[:, a] >= 0.5) & (tc[:, b] >= 0.5) & np.isfinite(length)
     if ok.sum() < 3:
         return float("nan")
