@@ -205,8 +205,7 @@ _HANG_LENGTH = 0.9
 _MIN_REST_FRAMES = 5
 
 
-def _hanging(cam: Camera, ok, s_px, e_px, w_px, depth, upper: float, fore: float,
-             length: float = _HANG_LENGTH) -> np.ndarray:
+def _hanging(cam: Camera, ok, s_px, e_px, w_px, depth, upper: float, fore: float) -> np.ndarray:
     """(T,) frames where the image shows a limb hanging straight (DESIGN.md's starting pose)."""
     down = (cam.R @ np.array([0.0, 0.0, -1.0]))[:2]
     down = down / max(np.linalg.norm(down), 1e-9)
@@ -216,7 +215,7 @@ def _hanging(cam: Camera, ok, s_px, e_px, w_px, depth, upper: float, fore: float
         n = np.linalg.norm(v, axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             out &= (v @ down) > np.cos(np.radians(_HANG_DEG)) * n
-            out &= n * depth / cam.focal > length * seg
+            out &= n * depth / cam.focal > _HANG_LENGTH * seg
     return out
 
 

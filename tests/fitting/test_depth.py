@@ -1,6 +1,7 @@
 """Choice of each arm segment's side of the image plane (:mod:`capture2notation.fitting.depth`)."""
 
 import numpy as np
+import pytest
 
 from capture2notation.body import Body, joint_index
 from capture2notation.fitting import Camera, FitOptions, fit_keypoints
@@ -82,68 +83,43 @@ def test_a_bent_elbow_tells_the_forearm_side_when_world_depth_says_nothing(synth
     assert np.mean(-fore_off[:, 2] / np.linalg.norm(fore_off, axis=1)) < np.mean(towards)
 
 
-def _with_rest_offset(world, up=0.23, fore=-0.22):
-    """BlazePose-like world landmarks: right elbow `up` upper arms behind the
-    shoulder, wrist `fore` forearms behind the elbow, in every pose."""
-    out = world.copy()
-    body = Body()
-    lu = np.linalg.norm(body.offsets[joint_index("right_elbow")])
-    lf = np.linalg.norm(body.offsets[joint_index("right_wrist")])
-    out[:, [14, 16, 18, 20, 22], 2] += up * lu
-    out[:, [16, 18, 20, 22], 2] += fore * lf
-    return out
+#: BlazePose landmarks of a right limb: its root, the points that move with
+#: its middle joint, those that move with its end; and its two joints.
+_LIMBS = {
+    "arm": (12, [14, 16, 18, 20, 22], [16, 18, 20, 22], ("right_shoulder", "right_elbow", "right_wrist")),
+    "leg": (24, [26, 28, 30, 32], [28, 30, 32], ("right_hip", "right_knee", "right_ankle")),
+}
 
 
-def test_the_world_landmarks_rest_offset_is_measured_on_the_hanging_arm_and_removed(synth):
-    # The arm hangs for 12 frames (DESIGN.md's starting pose), then rises
-    # forward low.  The world landmarks keep half of the depth and put the
-    # elbow 0.4 of the upper arm behind the shoulder in every pose (BlazePose
-    # on our renders: a quarter, with less of the depth): read as they come
-    # they put the raised upper arm behind too.
+@pytest.mark.parametrize("limb, pose, rest, seed", [
+    ("arm", {"right_shoulder": (0.785, 0.0, 0.0)}, 12, 5),
+    ("leg", {"right_hip": (0.6, 0.0, 0.0)}, 30, 6),
+])
+def test_the_landmarks_rest_offset_is_measured_on_the_hanging_limb_and_removed(limb, pose, rest, seed, synth):
+    # The limb hangs for `rest` frames (DESIGN.md's starting pose), then
+    # points forward low for 20.  The world landmarks keep half of its depth
+    # and put the middle joint 0.4 of the first segment behind the root in
+    # every pose, the end 0.4 of the second behind the middle joint
+    # (BlazePose on our renders: about a quarter, with less of the depth):
+    # read as they come they put the raised limb behind.  Seen from the
+    # front a leg lifted forward keeps most of its image length, so its
+    # frames count as hanging too; the standing ones outnumber them.
+    from capture2notation.fitting.depth import DepthOptions
+
+    root_lm, mid_lms, end_lms, (a, m, e) = _LIMBS[limb]
     body = Body()
-    rest, _ = synth.held_pose(12, body)
-    ahead, root = synth.held_pose(T, body, right_shoulder=(0.785, 0.0, 0.0))
-    ang, root = np.concatenate([rest, ahead]), np.concatenate([root[:12], root])
-    xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=5)
-    world[:, [14, 16, 18, 20, 22], 2] = world[:, [12], 2] + 0.5 * (world[:, [14, 16, 18, 20, 22], 2] - world[:, [12], 2])
-    world = _with_rest_offset(world, up=0.4, fore=-0.4)
-    assert np.all(_depth_sign(truth[12:], "right_shoulder", "right_elbow") < 0)
+    still, _ = synth.held_pose(rest, body)
+    ahead, root = synth.held_pose(20, body, **pose)
+    ang, root = np.concatenate([still, ahead]), np.concatenate([root[:1].repeat(rest, 0), root])
+    xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=seed)
+    world[:, mid_lms, 2] = world[:, [root_lm], 2] + 0.5 * (world[:, mid_lms, 2] - world[:, [root_lm], 2])
+    world[:, mid_lms, 2] += 0.4 * np.linalg.norm(body.offsets[joint_index(m)])
+    world[:, end_lms, 2] += 0.4 * np.linalg.norm(body.offsets[joint_index(e)])
+    assert np.all(_depth_sign(truth[rest:], a, m) < 0)
 
     def towards(options):
         res = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world, options=options)
-        return np.mean(_depth_sign(res.joints[12:], "right_shoulder", "right_elbow") < 0)
-
-    from capture2notation.fitting.depth import DepthOptions
-
-    assert towards(FitOptions(depth=DepthOptions(rest_offset=True))) >= 0.9
-    assert towards(FitOptions()) <= 0.1  # measured: behind (the default, for unbiased landmarks)
-
-
-def test_a_standing_legs_landmark_offset_is_removed_too(synth):
-    # Standing for 30 frames, then the right leg lifted forward low for 20.
-    # The world landmarks keep half of the leg's depth and put the knee 0.4
-    # of the thigh behind the hip in every pose, the ankle 0.4 of the shin
-    # behind the knee: read as they come the lifted leg goes back.  (Seen
-    # from the front the lifted leg keeps most of its image length, so its
-    # frames count as hanging too; the standing ones outnumber them.)
-    from capture2notation.fitting.depth import DepthOptions
-
-    body = Body()
-    rest, _ = synth.held_pose(30, body)
-    ahead, root = synth.held_pose(20, body, right_hip=(0.6, 0.0, 0.0))
-    ang, root = np.concatenate([rest, ahead]), np.concatenate([root[:1].repeat(30, 0), root])
-    xy, conf, world, truth = synth.observe(ang, root, CAM, body, noise_px=1.0, seed=6)
-    leg = [26, 28, 30, 32]  # right knee, ankle, heel, foot index
-    world[:, leg, 2] = world[:, [24], 2] + 0.5 * (world[:, leg, 2] - world[:, [24], 2])
-    thigh = np.linalg.norm(body.offsets[joint_index("right_knee")])
-    shin = np.linalg.norm(body.offsets[joint_index("right_ankle")])
-    world[:, leg, 2] += 0.4 * thigh
-    world[:, leg[1:], 2] += 0.4 * shin
-    assert np.all(_depth_sign(truth[30:], "right_hip", "right_ankle") < 0)
-
-    def towards(options):
-        res = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world, options=options)
-        return np.mean(_depth_sign(res.joints[30:], "right_hip", "right_ankle") < 0)
+        return np.mean(_depth_sign(res.joints[rest:], a, m) < 0)
 
     assert towards(FitOptions(depth=DepthOptions(rest_offset=True))) >= 0.9
     assert towards(FitOptions()) <= 0.1  # measured: behind (the default, for unbiased landmarks)
