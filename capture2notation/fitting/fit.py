@@ -264,8 +264,8 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body, floor: bool = 
     foreshortened when the landmarks flatten it.  With world landmarks, the
     frames where they call the segment flat (depth component under 0.25 of
     the length) give the median length; without, the 90th percentile over
-    the clip does.  The upper arms take the long end of all their frames
-    instead (:func:`_upper_arm_length`: the landmarks call many a
+    the clip does.  The upper arms take the longer of that and the long end
+    of all their frames (:func:`_upper_arm_length`: the landmarks call many a
     foreshortened arm flat, which measured them 10-15 % short on our
     renders) and the forearms their proportion to it; neither sets the
     figure's scale.  Only the proportions are kept (``relative=True`` in
