@@ -394,6 +394,19 @@ def segment_motion(
                         tempo_runner_up=detail.runner_up, tempo_confidence=detail.confidence)
 
 
+def _lands_at_end(down: np.ndarray, end_f: int, hold: int) -> bool:
+    """Whether a measured foot whose movement arrives at frame `end_f` lands as the clip ends.
+
+    A closing that arrives on the last frame has no hold after it: the
+    smoothed foot is still above DESIGN.md's 0.2 m/s until then and is in
+    contact on the last frame alone (nothing follows it,
+    :func:`~.labels.support_frames`).  A foot in contact there, its
+    movement's fitted arrival within a hold (`hold` frames) of the end, has
+    landed.
+    """
+    return bool(down[-1]) and end_f >= len(down) - 1 - hold
+
+
 def segment(joints: np.ndarray, fps: float, tempo=None, meter: int = 4, params: SegmentParams | None = None, floor: float = 0.0) -> Score:
     """The score of a motion (see :func:`segment_motion`)."""
     return segment_motion(joints, fps, tempo=tempo, meter=meter, params=params, floor=floor).score
@@ -679,6 +692,8 @@ def _gesture_movements(
                     # movement that arrives and holds its pose is a movement
                     # (half a beat at 96 bpm is fitted as quick as 0.17 s).
                     continue
+                # Nothing arrives after the clip ends (the fitted curve may run past it).
+                t1 = min(t1, (T - 1) / fps)
                 end_f = min(max(int(round(t1 * fps)), start_f + 1), T - 1)
                 frames = hold_frames(end_f, b + 1, nxt, hold, T)
             if arrivals is not None and arrivals[end_f] and not _key_pose_fn(labels, part)(end_f, start_f):
@@ -686,7 +701,8 @@ def _gesture_movements(
                 # no written pose was carried by the weight transfer (a foot
                 # a step left behind), not a gesture.
                 continue
-            if part in _FOOT and labels.supporting[end_f, _FOOT[part]]:
+            if part in _FOOT and (labels.supporting[end_f, _FOOT[part]]
+                                  or (not clean and _lands_at_end(labels.supporting[:, _FOOT[part]], end_f, hold))):
                 # A leg that arrives on the floor is a support, not a gesture.
                 state = ("place", "low", 0)
                 continue

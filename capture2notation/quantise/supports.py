@@ -268,7 +268,9 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     A centimetre of jitter makes the pelvis, knee and foot speeds as large
     as a plié's, so movements are not found from speed here.  Instead the
     support state (part, level) of the smoothed joints is mode-filtered over
-    0.3 s and cut into grounded runs of at least :data:`MIN_SUPPORT_S`; each
+    0.3 s and cut into grounded runs of at least :data:`MIN_SUPPORT_S` (a
+    last run on both feet may be shorter: a closing that lands on the
+    clip's last frame has nothing after it to hold); each
     change of state between consecutive runs is one movement, and so is a
     weight-bearing foot that left the floor and lands more than half a step
     (DESIGN.md step rule, :data:`STEP_MIN_FRACTION`) from under its hip (a
@@ -299,7 +301,16 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     w = max(3, int(round(0.3 * fps)) | 1)
     code = _mode_filter((part + 1) * 4 + (level + 1), w)
     min_len = max(1, int(round(MIN_SUPPORT_S * fps)))
-    runs = [r for r in _runs(code) if r[0] >= 4 and r[2] - r[1] + 1 >= min_len]  # grounded only
+    def held(c: int, a: int, b: int) -> bool:
+        # Grounded runs (code >= 4) held long enough.  The last may be short
+        # if it stands on both feet (code // 4 - 1 == 0): a closing that
+        # arrives on the clip's last frame has nothing after it to hold (a
+        # single foot there is as likely the fit's flicker).
+        if c < 4:
+            return False
+        return b - a + 1 >= min_len or (b == T - 1 and c // 4 - 1 == 0)
+
+    runs = [r for r in _runs(code) if held(*r)]
     height = _body_height(smooth)
     offset = _standing_foot_offset(smooth, labels.supporting)
     pelvis = joints[:, joint_index("pelvis")]
@@ -349,6 +360,8 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
             times = closing_times(smooth[:, joint_index(("right_ankle", "left_ankle")[free])],
                                   labels.supporting[:, free], min(prev_start, out[-1].start_frame if out else 0), a, fps)
             t0, t1 = times if times is not None else (t0, t1)
+        # Nothing arrives after the clip ends (the fitted curve may run past it).
+        t1 = min(t1, (T - 1) / fps)
         start = int(np.clip(round(t0 * fps), 0, T - 1))
         end = int(np.clip(round(t1 * fps), start + 1, T - 1))
         state = new

@@ -11,6 +11,7 @@ from __future__ import annotations
 from fractions import Fraction as F
 
 import numpy as np
+import pytest
 from scipy.ndimage import gaussian_filter1d
 
 from capture2notation.body import JOINTS, forward_kinematics, joint_index
@@ -248,8 +249,8 @@ def test_a_closing_is_timed_by_the_landing_foot_not_the_lagging_pelvis():
     """A fit smooths the pelvis: it moves a quarter of a second after the
     feet.  Timed from the pelvis, each closing was written half a beat
     late (its cell lost); the closing foot lands on time.  (The arm
-    gesture keeps the clip going past the last closing: one landing on
-    the clip's last frame is never held long enough to be seen.)"""
+    gesture keeps the clip going past the last closing; one landing on
+    the clip's last frame is the next test's.)"""
     score, joints = _interpret(STEP_CLOSE_HOLD)
     lag = 4
     legs = {joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("ankle", "toe")}
@@ -265,3 +266,48 @@ def test_a_closing_is_timed_by_the_landing_foot_not_the_lagging_pelvis():
         for want, start in zip((1, 4, 7), closes):
             assert abs(start - want) <= F(1, 4), got
 
+
+
+GESTURE_THEN_CLOSE = """\
+title: a leg gesture, closed on the last beat
+tempo: {tempo}
+meter: 4
+0  1   left_support  place   middle
+1  2   right_leg     right   low
+3  2   support       place   middle
+"""
+
+
+@pytest.mark.parametrize("tempo", [60, 96])
+def test_a_closing_that_lands_on_the_last_frame_is_a_support(tempo):
+    """The phrase ends as the free foot lands: nothing follows to hold the
+    closing, so the smoothed foot is in contact on the last frame alone
+    (at 96 bpm) or a few.  It was written as a leg gesture to ``place low``
+    with the weight left on the other foot (two cells of each column lost
+    on a held-out phrase through BlazePose), or not at all; and a fitted
+    arrival a little past the end lengthened the score beyond the clip."""
+    score, joints = _interpret(GESTURE_THEN_CLOSE.format(tempo=tempo))
+    for seed in (0, 1):
+        noisy = joints + _correlated(joints.shape, 0.004, seed, width_frames=3.0)
+        got = normalise(segment_motion(noisy, FPS, tempo=score.tempo).score)
+        last = [s for s in got.symbols if s.start >= 2]
+        closes = [s for s in last if s.is_support]
+        assert [(s.part, s.direction) for s in closes] == [("support", "place")], got
+        assert abs(closes[0].start - 3) <= F(1, 2), got
+        assert not [s for s in last if s.part == "right_leg"], got
+        assert max(s.start + s.duration for s in got.symbols) <= score.duration, got
+
+
+@pytest.mark.parametrize("cut", [6, 10])
+def test_no_symbol_outlasts_a_clip_cut_mid_movement(cut):
+    """A clip that ends during the last movement (the recording stopped):
+    the Effort logistic fitted to its progress arrives after the last frame,
+    which wrote symbols up to a beat past the end of the clip."""
+    score, joints = _interpret(GESTURE_THEN_CLOSE.format(tempo=60))
+    joints = joints[:-cut]
+    last = (joints.shape[0] - 1) / FPS
+    for seed in (0, 1):
+        noisy = joints + _correlated(joints.shape, 0.004, seed, width_frames=3.0)
+        got = segment_motion(noisy, FPS, tempo=score.tempo).score
+        end = max(s.start + s.duration for s in got.symbols) * 60 / score.tempo
+        assert end <= last + 0.125 * 60 / score.tempo, got  # within half a grid step
