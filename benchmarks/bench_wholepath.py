@@ -54,6 +54,7 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
                     **({} if flip_test is None else {"flip_test": flip_test}))
     seconds = time.perf_counter() - t0
     a = compare_scores(score, video.score)
+    cells = agreement_cells(score, video.score)
     truth = read_truth(render / "truth.npz")
     return {
         "phrase": path.stem,
@@ -67,7 +68,8 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
         "mpjpe_cm": 100 * float(np.nanmean(mpjpe(np.asarray(truth.joints), np.asarray(video.motion.joints)))),
         "fps": truth.n_frames / seconds,
         "frames": truth.n_frames,
-        "missed": [c for c in agreement_cells(score, video.score) if c.ref != c.cand],
+        "missed": [c for c in cells if c.ref != c.cand],
+        "cells": len(cells),
     }
 
 
@@ -105,6 +107,10 @@ def main() -> None:
     how = "given" if args.tempo_given else "estimated"
     print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames, tempo {how}:")
     print(f"  symbol agreement (mean over phrases)  {np.mean([r['agreement'] for r in rows]):.1%}")
+    # The columns compared are the parts either score moves, so a capture
+    # that writes fewer spurious symbols can lose cells *and* percentage:
+    # the lost cells say which.
+    print(f"  cells lost / compared                 {sum(len(r['missed']) for r in rows)} / {sum(r['cells'] for r in rows)}")
     print(f"  median start error                    {np.nanmedian([r['start_error'] for r in rows]):.2f} beat")
     print(f"  truth captures exact                  {sum(r['truth_exact'] for r in rows)}/{len(rows)}")
     print(f"  median limb-direction error           {np.median([r['limb_deg'] for r in rows]):.1f}°")

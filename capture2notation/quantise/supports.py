@@ -31,8 +31,10 @@ sinks the feet by centimetres and barely bends a knee seen from the front,
 so there a foot flickering out of contact with the pelvis still between
 the feet keeps supporting (:func:`_balanced_contacts`), pliés are read from
 the pelvis height (:func:`_pelvis_plie`), a step must move the foot with
-the weight following (:func:`_plausible_step`), and the flight of a step
-belongs to the step (:func:`_join_flights`).
+the weight following (:func:`_plausible_step`), the flight of a step
+belongs to the step (:func:`_join_flights`), and a one-foot support that
+frees no foot (both stay on the floor while the fitted pelvis drifts over
+one of them) is a support on both (:func:`_feet_that_stay_down`).
 """
 
 from __future__ import annotations
@@ -311,6 +313,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         return b - a + 1 >= min_len or (b == T - 1 and c // 4 - 1 == 0)
 
     runs = [r for r in _runs(code) if held(*r)]
+    runs = _feet_that_stay_down(runs, labels.supporting, min_len)
     height = _body_height(smooth)
     offset = _standing_foot_offset(smooth, labels.supporting)
     pelvis = joints[:, joint_index("pelvis")]
@@ -368,6 +371,46 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         out.append(Movement(_SUPPORT_PARTS[new_part], start, end, max(t0, 0.0), t1, direction, LEVELS[new_level], 0))
         prev_start, prev_end = a, b
     return _drop_unheld(_join_flights(out, smooth))
+
+
+def _feet_that_stay_down(runs: list, contact: np.ndarray, min_len: int) -> list:
+    """Grounded runs with a one-foot support that no foot left the floor for read as on both feet.
+
+    DESIGN.md: a foot supports while it is on the floor and still.  The
+    pelvis decides which of two grounded feet carry the weight
+    (:func:`weight_bearing`), but a fitted pelvis drifts across the feet
+    by several centimetres (along the camera's depth, which a 45° view
+    mixes into the body's sideways axis) and crosses the quarter-way mark:
+    a one-foot support written while both feet stood, typically for the
+    last beats of a phrase.  A dancer's weight goes onto one foot to free
+    the other, which then leaves the floor (a gesture, a step's flight);
+    so a one-foot run is kept only if, since the last run on both feet, a
+    foot was off the floor for at least `min_len` frames.
+
+    Parameters
+    ----------
+    runs : list of (code, first, last)
+        Grounded runs (:func:`_runs` of ``(part + 1) * 4 + (level + 1)``).
+    contact : (T, 2) ndarray of bool
+        Feet in contact.
+    min_len : int
+        Frames off the floor that make a lift rather than flicker.
+
+    Returns
+    -------
+    list of (code, first, last)
+    """
+    out = []
+    since = 0  # first frame after the last run on both feet
+    for c, a, b in runs:
+        if c // 4 - 1 == 0:
+            since = b + 1
+        else:
+            off = (~np.asarray(contact[since : b + 1], bool)).sum(axis=0)
+            if np.all(off < min_len):
+                c = 4 + c % 4  # both feet, same level
+        out.append((c, a, b))
+    return out
 
 
 def _drop_unheld(moves: list) -> list:

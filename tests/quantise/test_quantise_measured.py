@@ -311,3 +311,32 @@ def test_no_symbol_outlasts_a_clip_cut_mid_movement(cut):
         got = segment_motion(noisy, FPS, tempo=score.tempo).score
         end = max(s.start + s.duration for s in got.symbols) * 60 / score.tempo
         assert end <= last + 0.125 * 60 / score.tempo, got  # within half a grid step
+
+
+def test_a_pelvis_drifting_over_one_foot_while_both_stand_is_no_transfer():
+    """Both feet stay on the floor while the fitted pelvis drifts 7 cm
+    sideways, past the quarter-way mark to the right foot (a 45° view puts
+    half the fit's depth error on that axis).  A one-foot support was
+    written for the rest of the phrase; DESIGN.md's feet that stay on the
+    floor both support, and a weight transfer frees a foot that then
+    leaves the floor."""
+    tempo = 72.0
+    T = int(round(8 * 60.0 / tempo * FPS)) + 1
+    joints = forward_kinematics(np.zeros((T, len(JOINTS), 3)))
+    feet = {joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("ankle", "toe", "heel")
+            if f"{s}_{j}" in JOINTS}
+    body = [j for j in range(len(JOINTS)) if j not in feet]
+    joints[:, body, 0] += 0.07 * _ease(T, tempo, 5, 1)[:, None]
+    for seed in (0, 1):
+        noisy = joints + _correlated(joints.shape, 0.004, seed)
+        assert _supports(segment_motion(noisy, FPS, tempo=tempo).score) == [], seed
+
+
+def test_a_transfer_that_frees_a_gesturing_leg_is_kept():
+    """The same pelvis travel onto the left foot, then the right leg lifts
+    to the side: the transfer stays a one-foot support."""
+    score, joints = _interpret(GESTURE_THEN_CLOSE.format(tempo=72))
+    for seed in (0, 1):
+        noisy = joints + _correlated(joints.shape, 0.004, seed, width_frames=3.0)
+        sup = _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)
+        assert [(p, d) for _, _, p, d, _ in sup] == [("left_support", "place"), ("support", "place")], sup
