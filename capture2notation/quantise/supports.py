@@ -313,7 +313,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         return b - a + 1 >= min_len or (b == T - 1 and c // 4 - 1 == 0)
 
     runs = [r for r in _runs(code) if held(*r)]
-    runs = _feet_that_stay_down(runs, labels.supporting, min_len)
+    runs = _feet_that_stay_down(runs, _lifted(labels.supporting, smooth, fps), min_len)
     height = _body_height(smooth)
     offset = _standing_foot_offset(smooth, labels.supporting)
     pelvis = joints[:, joint_index("pelvis")]
@@ -373,7 +373,30 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     return _drop_unheld(_join_flights(out, smooth))
 
 
-def _feet_that_stay_down(runs: list, contact: np.ndarray, min_len: int) -> list:
+def _lifted(contact: np.ndarray, joints: np.ndarray, fps: float) -> np.ndarray:
+    """(T, 2) feet off the floor that are lifted or moving, not floating by a fit's error.
+
+    A foot out of contact counts when it travels (a gesture, a step's
+    flight: DESIGN.md's 0.2 m/s, horizontally) or stands higher than the
+    other foot by more than :data:`BALANCE_FOOT_M`; a fitted foot in
+    relevé rises and floats a few centimetres out of the contact band
+    without either.
+    """
+    from .labels import SUPPORT_SPEED_MS
+
+    low, speed = [], []
+    for side in ("right", "left"):
+        a, t = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
+        low.append(np.fmin(a[:, 2], t[:, 2]))
+        step = np.linalg.norm(np.diff(0.5 * (a + t)[:, :2], axis=0), axis=-1) * fps
+        speed.append(np.r_[step, step[-1:]] if step.size else np.zeros(len(a)))
+    out = ~np.asarray(contact, bool)
+    for k in range(2):
+        out[:, k] &= (speed[k] >= SUPPORT_SPEED_MS) | (low[k] > low[1 - k] + BALANCE_FOOT_M)
+    return out
+
+
+def _feet_that_stay_down(runs: list, lifted: np.ndarray, min_len: int) -> list:
     """Grounded runs with a one-foot support that no foot left the floor for read as on both feet.
 
     DESIGN.md: a foot supports while it is on the floor and still.  The
@@ -385,14 +408,14 @@ def _feet_that_stay_down(runs: list, contact: np.ndarray, min_len: int) -> list:
     last beats of a phrase.  A dancer's weight goes onto one foot to free
     the other, which then leaves the floor (a gesture, a step's flight);
     so a one-foot run is kept only if, since the last run on both feet, a
-    foot was off the floor for at least `min_len` frames.
+    foot was lifted (:func:`_lifted`) for at least `min_len` frames.
 
     Parameters
     ----------
     runs : list of (code, first, last)
         Grounded runs (:func:`_runs` of ``(part + 1) * 4 + (level + 1)``).
-    contact : (T, 2) ndarray of bool
-        Feet in contact.
+    lifted : (T, 2) ndarray of bool
+        Feet off the floor (:func:`_lifted`).
     min_len : int
         Frames off the floor that make a lift rather than flicker.
 
@@ -406,7 +429,7 @@ def _feet_that_stay_down(runs: list, contact: np.ndarray, min_len: int) -> list:
         if c // 4 - 1 == 0:
             since = b + 1
         else:
-            off = (~np.asarray(contact[since : b + 1], bool)).sum(axis=0)
+            off = np.asarray(lifted[since : b + 1], bool).sum(axis=0)
             if np.all(off < min_len):
                 c = 4 + c % 4  # both feet, same level
         out.append((c, a, b))
