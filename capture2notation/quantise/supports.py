@@ -256,6 +256,16 @@ MIN_PELVIS_M = 0.025
 MIN_SUPPORT_S = 0.2
 
 
+def _state_code(part, level):
+    """One integer per support state (part and level indices, −1 in the air), for runs and mode filters."""
+    return (part + 1) * 4 + (level + 1)
+
+
+def _state_of(code: int) -> tuple[int, int]:
+    """(part, level) of a :func:`_state_code`."""
+    return code // 4 - 1, code % 4 - 1
+
+
 def _runs(code: np.ndarray) -> list[tuple[int, int, int]]:
     """Runs of equal values: (value, first frame, last frame)."""
     edges = np.flatnonzero(np.diff(code)) + 1
@@ -301,16 +311,18 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
                       "is the floor height right?): no support symbols written", stacklevel=3)
         return []
     w = max(3, int(round(0.3 * fps)) | 1)
-    code = _mode_filter((part + 1) * 4 + (level + 1), w)
+    code = _mode_filter(_state_code(part, level), w)
     min_len = max(1, int(round(MIN_SUPPORT_S * fps)))
+
     def held(c: int, a: int, b: int) -> bool:
-        # Grounded runs (code >= 4) held long enough.  The last may be short
-        # if it stands on both feet (code // 4 - 1 == 0): a closing that
-        # arrives on the clip's last frame has nothing after it to hold (a
-        # single foot there is as likely the fit's flicker).
-        if c < 4:
+        # Grounded runs held long enough.  The last may be short if it
+        # stands on both feet: a closing that arrives on the clip's last
+        # frame has nothing after it to hold (a single foot there is as
+        # likely the fit's flicker).
+        p, _ = _state_of(c)
+        if p < 0:
             return False
-        return b - a + 1 >= min_len or (b == T - 1 and c // 4 - 1 == 0)
+        return b - a + 1 >= min_len or (b == T - 1 and p == 0)
 
     runs = [r for r in _runs(code) if held(*r)]
     runs = _feet_that_stay_down(runs, _lifted(labels.supporting, smooth, fps), min_len)
@@ -324,7 +336,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     # Last frame each foot bore weight in a grounded run.
     bore = {0: 0, 1: 0}
     for c, a, b in runs:
-        new_part, new_level = c // 4 - 1, c % 4 - 1
+        new_part, new_level = _state_of(c)
         # A step needs a flight: a weight-bearing foot off the floor between
         # the two runs (a swaying pelvis or a sliding fitted foot is no step).
         feet = {0: (0, 1), 1: (0,), 2: (1,)}[new_part]
@@ -413,7 +425,7 @@ def _feet_that_stay_down(runs: list, lifted: np.ndarray, min_len: int) -> list:
     Parameters
     ----------
     runs : list of (code, first, last)
-        Grounded runs (:func:`_runs` of ``(part + 1) * 4 + (level + 1)``).
+        Grounded runs (:func:`_runs` of :func:`_state_code`).
     lifted : (T, 2) ndarray of bool
         Feet off the floor (:func:`_lifted`).
     min_len : int
@@ -426,12 +438,11 @@ def _feet_that_stay_down(runs: list, lifted: np.ndarray, min_len: int) -> list:
     out = []
     since = 0  # first frame after the last run on both feet
     for c, a, b in runs:
-        if c // 4 - 1 == 0:
+        part, level = _state_of(c)
+        if part == 0:
             since = b + 1
-        else:
-            off = np.asarray(lifted[since : b + 1], bool).sum(axis=0)
-            if np.all(off < min_len):
-                c = 4 + c % 4  # both feet, same level
+        elif np.all(np.asarray(lifted[since : b + 1], bool).sum(axis=0) < min_len):
+            c = _state_code(0, level)
         out.append((c, a, b))
     return out
 
