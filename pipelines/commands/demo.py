@@ -51,6 +51,9 @@ class DemoResult:
         original after alignment (from the score report), millimetres.
     seconds : dict of str to float
         Wall-clock time of each stage of the capture.
+    differences : tuple of (str, float, str, str)
+        The (part, beat, written, captured) cells the agreement misses,
+        beats of the original counted from 0.
     """
 
     phrase: str
@@ -62,6 +65,7 @@ class DemoResult:
     limb_error_deg: float
     mpjpe_mm: float
     seconds: dict
+    differences: tuple = ()
 
     def line(self) -> str:
         """One line a person reads in the terminal."""
@@ -85,7 +89,7 @@ def run_phrase(name: str, score, folder: Path, *, fps: float, size, view: str, s
                effort: bool, progress: bool) -> DemoResult:
     """Render `score`, capture the video, compare with the original; see :class:`DemoResult`."""
     from capture2notation.io.truth import read_truth
-    from capture2notation.quantise.agreement import compare_scores
+    from capture2notation.quantise.agreement import agreement_cells, compare_scores
     from pipelines.capture import capture
     from pipelines.score import run_score
     from synthetic.render import render_score
@@ -106,6 +110,8 @@ def run_phrase(name: str, score, folder: Path, *, fps: float, size, view: str, s
         limb_error_deg=_limb_error(np.asarray(truth.joints), np.asarray(cap.motion.joints)),
         mpjpe_mm=float(summary["mpjpe_mm"]),
         seconds=dict(cap.seconds),
+        differences=tuple((c.part, float(c.beat) - 0.5, " ".join(c.ref), " ".join(c.cand))
+                          for c in agreement_cells(score, cap.score) if c.ref != c.cand),
     )
 
 
@@ -171,8 +177,21 @@ BlazePose, the 3D fit and the quantiser back to notation, which is compared here
 <th>median start error (beats)</th><th>tempo written / captured (bpm)</th><th>limb direction error (median)</th>
 <th>MPJPE (mm)</th><th>original</th><th>notation</th><th>report</th></tr>
 {"".join(rows)}
-</table></body></html>
+</table>
+{"".join(_differences_html(r) for r in results)}
+</body></html>
 """
+
+
+def _differences_html(r: DemoResult) -> str:
+    """Where one phrase's captured score differs from the original, beat by beat."""
+    name = html.escape(r.phrase)
+    if not r.differences:
+        return f"<h2>{name}</h2><p>The captured score agrees with the original on every beat.</p>\n"
+    rows = "".join(f"<tr><td>{html.escape(part)}</td><td>{beat:g}</td><td>{html.escape(w)}</td><td>{html.escape(c)}</td></tr>"
+                   for part, beat, w, c in r.differences)
+    return (f"<h2>{name}: where the capture differs</h2>\n<table><tr><th>part</th><th>beat</th>"
+            f"<th>written</th><th>captured</th></tr>{rows}</table>\n")
 
 
 @click.command("demo")
