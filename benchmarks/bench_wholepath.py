@@ -12,8 +12,8 @@ the mannequin, and captured twice:
   (or given, ``--tempo-given``).
 
 Printed (never asserted): per phrase and overall, the symbol agreement
-(direction + level per part per beat of the original), the median start-time
-error in beats, whether the truth capture is exact, the median limb-direction
+(direction + level per part per beat of the original) and overall the
+cells lost out of those compared, the median start-time error in beats, whether the truth capture is exact, the median limb-direction
 error and MPJPE of the fit, and frames per second of the whole video capture.
 With ``--explain``, under each phrase, the beats it loses: per part, the
 reference's state and the capture's
