@@ -385,6 +385,16 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     return _drop_unheld(_join_flights(out, smooth))
 
 
+def _feet(joints: np.ndarray) -> tuple[list, list]:
+    """Each foot's (right, left) lowest point height (T,) and centre (T, 3): toe and ankle."""
+    low, mid = [], []
+    for side in ("right", "left"):
+        a, t = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
+        low.append(np.fmin(a[:, 2], t[:, 2]))
+        mid.append(0.5 * (a + t))
+    return low, mid
+
+
 def _lifted(contact: np.ndarray, joints: np.ndarray, fps: float) -> np.ndarray:
     """(T, 2) feet off the floor that are lifted or moving, not floating by a fit's error.
 
@@ -396,15 +406,12 @@ def _lifted(contact: np.ndarray, joints: np.ndarray, fps: float) -> np.ndarray:
     """
     from .labels import SUPPORT_SPEED_MS
 
-    low, speed = [], []
-    for side in ("right", "left"):
-        a, t = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
-        low.append(np.fmin(a[:, 2], t[:, 2]))
-        step = np.linalg.norm(np.diff(0.5 * (a + t)[:, :2], axis=0), axis=-1) * fps
-        speed.append(np.r_[step, step[-1:]] if step.size else np.zeros(len(a)))
+    low, mid = _feet(joints)
     out = ~np.asarray(contact, bool)
     for k in range(2):
-        out[:, k] &= (speed[k] >= SUPPORT_SPEED_MS) | (low[k] > low[1 - k] + BALANCE_FOOT_M)
+        step = np.linalg.norm(np.diff(mid[k][:, :2], axis=0), axis=-1) * fps
+        speed = np.r_[step, step[-1:]] if step.size else np.zeros(len(out))
+        out[:, k] &= (speed >= SUPPORT_SPEED_MS) | (low[k] > low[1 - k] + BALANCE_FOOT_M)
     return out
 
 
@@ -570,11 +577,7 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
     if sup.shape[0] < 2:
         return labels
     pelvis = joints[:, joint_index("pelvis"), :2]
-    low, mid = [], []
-    for side in ("right", "left"):
-        a, t = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
-        low.append(np.fmin(a[:, 2], t[:, 2]))
-        mid.append(0.5 * (a + t))
+    low, mid = _feet(joints)
     d = mid[1][:, :2] - mid[0][:, :2]
     with np.errstate(invalid="ignore", divide="ignore"):
         u = np.sum((pelvis - mid[0][:, :2]) * d, axis=-1) / np.sum(d * d, axis=-1)
