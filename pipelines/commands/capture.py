@@ -40,7 +40,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
     tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
     result = run(input_path, outdir, backend=backend, tempo=tempo_value, fps_override=fps_override, progress=True,
                  params=SegmentParams(grid=step), effort=not no_effort, seed=seed, flip_test=flip_test)
-    how = tempo_note(result.segmentation) if result.segmentation.tempo_estimated else " (given)"
+    how = tempo_note(result.segmentation, result.kind) if result.segmentation.tempo_estimated else " (given)"
     click.echo(f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
                f"({result.kind}), tempo {result.score.tempo} bpm{how}")
     for note in result.skipped:

@@ -93,6 +93,17 @@ def test_estimated_tempo_and_fps_override(sidecar, tmp_path):
     assert score_differences(EXPECTED, res2.score.replace(tempo=TEMPO)) == []
 
 
+def test_tempo_note_of_a_video_says_how_often_it_was_right_not_the_model_confidence():
+    from types import SimpleNamespace
+
+    from pipelines.capture import tempo_note
+
+    seg = SimpleNamespace(tempo_confidence=0.85, tempo_runner_up=72)
+    assert tempo_note(seg) == " (estimated, 85% sure; else 72 bpm; give --tempo to fix it)"
+    video = tempo_note(seg, "video")
+    assert "%" not in video and "else 72 bpm" in video and "give --tempo" in video
+
+
 def test_command_line(sidecar, tmp_path):
     runner = CliRunner()
     r = runner.invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "c"), "--tempo", str(TEMPO), "--no-effort"])
