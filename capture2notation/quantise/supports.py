@@ -59,6 +59,21 @@ STEP_MIN_FRACTION = 0.09
 _SUPPORT_PARTS = ("support", "right_support", "left_support")
 
 
+#: Fraction of the way from one foot to the other within which the pelvis
+#: is over the nearer foot (:func:`weight_bearing`).
+OVER_FOOT_FRACTION = 0.25
+
+
+def _fraction_along(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """How far point `p` lies along the way from `a` to `b` (0 at `a`, 1 at `b`), by projection.
+
+    Arrays ``(..., 2)`` (horizontal positions); NaN where `a` and `b` coincide.
+    """
+    d = b - a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.sum((p - a) * d, axis=-1) / np.sum(d * d, axis=-1)
+
+
 def weight_bearing(joints: np.ndarray, contact: np.ndarray) -> np.ndarray:
     """Feet that carry the weight.
 
@@ -72,18 +87,13 @@ def weight_bearing(joints: np.ndarray, contact: np.ndarray) -> np.ndarray:
     -------
     (T, 2) ndarray of bool
     """
-    pelvis = joints[:, joint_index("pelvis"), :2]
-    fr = 0.5 * (joints[:, joint_index("right_ankle"), :2] + joints[:, joint_index("right_toe"), :2])
-    fl = 0.5 * (joints[:, joint_index("left_ankle"), :2] + joints[:, joint_index("left_toe"), :2])
-    d = fl - fr
-    n2 = np.sum(d * d, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        u = np.sum((pelvis - fr) * d, axis=-1) / n2
+    _, (fr, fl) = _feet(joints)
+    u = _fraction_along(joints[:, joint_index("pelvis"), :2], fr[:, :2], fl[:, :2])
     both = contact.all(axis=1)
     wb = contact.copy()
     # Only when both feet are down does the pelvis decide between them.
-    wb[:, 1] &= ~(both & (u < 0.25))
-    wb[:, 0] &= ~(both & (u > 0.75))
+    wb[:, 1] &= ~(both & (u < OVER_FOOT_FRACTION))
+    wb[:, 0] &= ~(both & (u > 1.0 - OVER_FOOT_FRACTION))
     return wb
 
 
@@ -508,11 +518,6 @@ def _join_flights(moves: list, joints: np.ndarray | None = None) -> list:
     return out
 
 
-#: Fraction of the way from one foot to the other within which the pelvis
-#: is over the nearer foot (as :func:`weight_bearing` judges it).
-OVER_FOOT_FRACTION = 0.25
-
-
 def _pelvis_over_foot(joints: np.ndarray, move) -> bool:
     """Whether a one-foot support movement ends with the pelvis over its foot.
 
@@ -524,13 +529,10 @@ def _pelvis_over_foot(joints: np.ndarray, move) -> bool:
     T = joints.shape[0]
     a = int(np.clip(move.start_frame, 0, T - 1))
     f = int(np.clip(move.end_frame, 0, T - 1))
-    pelvis = joints[f, joint_index("pelvis"), :2]
-    fr = joints[a, joint_index("right_ankle"), :2]
-    d = joints[a, joint_index("left_ankle"), :2] - fr
-    n2 = float(d @ d)
-    if not n2 > 1e-6:
+    fr, fl = joints[a, joint_index("right_ankle"), :2], joints[a, joint_index("left_ankle"), :2]
+    if not float(np.sum((fl - fr) ** 2)) > 1e-6:
         return False
-    u = float((pelvis - fr) @ d) / n2
+    u = float(_fraction_along(joints[f, joint_index("pelvis"), :2], fr, fl))
     if move.part == "right_support":
         return u < OVER_FOOT_FRACTION
     return u > 1.0 - OVER_FOOT_FRACTION
@@ -578,10 +580,8 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
         return labels
     pelvis = joints[:, joint_index("pelvis"), :2]
     low, mid = _feet(joints)
-    d = mid[1][:, :2] - mid[0][:, :2]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        u = np.sum((pelvis - mid[0][:, :2]) * d, axis=-1) / np.sum(d * d, axis=-1)
-    between = (u > 0.25) & (u < 0.75)
+    u = _fraction_along(pelvis, mid[0][:, :2], mid[1][:, :2])
+    between = (u > OVER_FOOT_FRACTION) & (u < 1.0 - OVER_FOOT_FRACTION)
     out = sup.copy()
     for k in range(2):
         step = np.linalg.norm(np.diff(mid[k], axis=0), axis=-1) * fps
