@@ -18,6 +18,12 @@ error and MPJPE of the fit, and frames per second of the whole video capture.
 With ``--explain``, under each phrase, the beats it loses: per part, the
 reference's state and the capture's
 (:func:`capture2notation.quantise.agreement.agreement_cells`).
+
+With ``--keypoints render`` the fit is given the renderer's own landmarks
+(their pixels, and their positions in camera axes about the hips as world
+landmarks) in place of BlazePose's: what the fit and the quantiser make of
+perfect keypoints, which separates what perception loses from what they
+lose.  The speed is then that of fitting and quantising alone.
 """
 
 from __future__ import annotations
@@ -32,8 +38,42 @@ import numpy as np
 HOLDOUT = Path(__file__).resolve().parent / "holdout"
 
 
+def render_track(truth):
+    """The renderer's landmarks as a :class:`~capture2notation.keypoints.KeypointTrack`: perfect keypoints.
+
+    Pixels from the sidecar's projected landmarks, world landmarks from their
+    3D positions in the camera's axes about the hips' midpoint (BlazePose's
+    convention), every landmark inside the image at confidence 1 (a hidden
+    one too: a keypoint model places those as well); no image depth.
+    """
+    from capture2notation.keypoints import KeypointTrack
+
+    track = KeypointTrack.empty(truth.n_frames, truth.fps, truth.image_size, backend="render", times=truth.times)
+    xy = track.xy.copy()
+    xy[..., :2] = truth.keypoints
+    camera_axes = np.asarray(truth.landmarks3d) @ np.asarray(truth.R).T
+    world = camera_axes - 0.5 * (camera_axes[:, 23] + camera_axes[:, 24])[:, None]
+    w, h = truth.image_size
+    inside = (xy[..., 0] >= 0) & (xy[..., 0] < w) & (xy[..., 1] >= 0) & (xy[..., 1] < h)
+    return KeypointTrack(fps=truth.fps, times=truth.times, image_size=truth.image_size, xy=xy,
+                         visibility=inside.astype(float), presence=np.ones(truth.n_frames),
+                         world=world, crops=track.crops, backend="render")
+
+
+def _capture_render_keypoints(truth, tempo):
+    """Fit and quantise the renderer's own landmarks (see :func:`render_track`)."""
+    from types import SimpleNamespace
+
+    from capture2notation.fitting import Camera, fit_track
+    from capture2notation.quantise.segment import segment_motion
+
+    motion = fit_track(render_track(truth), camera=Camera.from_truth(truth))
+    seg = segment_motion(np.asarray(motion.joints), float(motion.fps), tempo=tempo)
+    return SimpleNamespace(score=seg.score, motion=motion)
+
+
 def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: bool = False,
-            flip_test: bool | None = None) -> dict:
+            flip_test: bool | None = None, keypoints: str = "blazepose") -> dict:
     """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
     from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
@@ -48,14 +88,17 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
                           progress=False)
     from_truth = capture(render / "truth.npz", workdir / "truth", tempo=score.tempo, progress=False, effort=False)
     exact = compare_scores(score, from_truth.score).exact
+    truth = read_truth(render / "truth.npz")
     t0 = time.perf_counter()
-    video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False,
-                    tempo=score.tempo if tempo_given else None,
-                    **({} if flip_test is None else {"flip_test": flip_test}))
+    if keypoints == "render":
+        video = _capture_render_keypoints(truth, score.tempo if tempo_given else None)
+    else:
+        video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False,
+                        tempo=score.tempo if tempo_given else None,
+                        **({} if flip_test is None else {"flip_test": flip_test}))
     seconds = time.perf_counter() - t0
     a = compare_scores(score, video.score)
     cells = agreement_cells(score, video.score)
-    truth = read_truth(render / "truth.npz")
     return {
         "phrase": path.stem,
         "agreement": a.symbol_agreement,
@@ -90,12 +133,15 @@ def main() -> None:
     ap.add_argument("--explain", action="store_true", help="list the beats each phrase loses")
     ap.add_argument("--flip-test", action=argparse.BooleanOptionalAction, default=None,
                     help="BlazePose's mirrored second pass (default: capture's default)")
+    ap.add_argument("--keypoints", default="blazepose", choices=("blazepose", "render"),
+                    help="render: fit the renderer's own landmarks instead (perfect keypoints)")
     args = ap.parse_args()
     paths = sorted(args.phrases.glob("*.lab"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for p in paths:
-            r = measure(p, Path(tmp) / p.stem, args.view, args.effort, args.tempo_given, args.flip_test)
+            r = measure(p, Path(tmp) / p.stem, args.view, args.effort, args.tempo_given, args.flip_test,
+                        args.keypoints)
             rows.append(r)
             print(f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
                   f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
@@ -105,7 +151,7 @@ def main() -> None:
     frames = sum(r["frames"] for r in rows)
     weights = np.array([r["frames"] for r in rows], float)
     how = "given" if args.tempo_given else "estimated"
-    print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames, tempo {how}:")
+    print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames, tempo {how}, {args.keypoints} keypoints:")
     print(f"  symbol agreement (mean over phrases)  {np.mean([r['agreement'] for r in rows]):.1%}")
     # The columns compared are the parts either score moves, so a capture
     # that writes fewer spurious symbols can lose cells *and* percentage:

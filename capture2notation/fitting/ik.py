@@ -174,7 +174,65 @@ def _limb(ang, P, G_parent, root, mid, end, sign, lim):
     euler = np.stack(euler)  # (4, T, 3)
     cos = np.sum(-euler_to_matrix(euler)[..., :, 2] * u_l, axis=-1)  # (4, T)
     pick = np.where(cos[0] >= cos.max(axis=0) - 0.02, 0, np.argmax(cos, axis=0))
-    ang[:, r] = np.where(ok_u[:, None], euler[pick, np.arange(len(pick))], 0.0)
+    chosen = euler[pick, np.arange(len(pick))]
+    ang[:, r] = np.where(ok_u[:, None], _continuous(chosen, u_l, ok_u & ~bent, cos.max(axis=0), lim[r]), 0.0)
     beta = np.arccos(np.clip(np.sum(u_l * f_l, axis=1), -1, 1))
     flex = np.where(np.isfinite(beta) & ok_u, sign * beta, 0.0)
     ang[:, m, 0] = np.clip(flex, lim[m, 0, 0], lim[m, 0, 1])
+
+
+def _continuous(chosen: np.ndarray, u: np.ndarray, free: np.ndarray, best_cos: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """Root-joint angles that follow on from frame to frame.
+
+    Chosen frame by frame, a straight limb's start jumped between twists and
+    between the two Euler triples of one rotation as it straightened or
+    passed the side (rz −100° → 175°, rx to its 200° limit), and the
+    smoothed solve between two branches pointed an arm 15–35° off for a
+    beat.  So where the limb is straight (`free`: its twist is not seen), the
+    last frame's rotation is carried on by the shortest swing onto this
+    frame's direction; and in every frame the Euler triple nearer the last
+    frame's is kept.
+
+    Parameters
+    ----------
+    chosen : (T, 3) ndarray
+        Per-frame choice (Euler angles, radians, within the limits).
+    u : (T, 3) ndarray
+        Segment direction in the parent's frame (unit).
+    free : (T,) ndarray of bool
+        Frames whose twist may be carried on (straight limb, direction known).
+    best_cos : (T,) ndarray
+        Cosine to `u` of the best per-frame candidate: a carried rotation
+        that the limits keep further than 0.02 below it is not used.
+    lim : (3, 2) ndarray
+        The joint's limits, radians.
+    """
+    out = chosen.copy()
+    last = None
+    for t in range(len(out)):
+        if not np.all(np.isfinite(u[t])):
+            continue
+        cands = [out[t]]
+        if free[t] and last is not None:
+            R = euler_to_matrix(last)
+            a = -R[:, 2]
+            axis = np.cross(a, u[t])
+            s = np.linalg.norm(axis)
+            if s > 1e-9:
+                R = _rodrigues(axis / s, np.arctan2(s, float(a @ u[t]))) @ R
+            carried = _euler_in_limits(R, lim)
+            if -euler_to_matrix(carried)[:, 2] @ u[t] >= best_cos[t] - 0.02:
+                cands = [carried]
+        cands.append(_other_triple(cands[0], lim))
+        ok = [c for c in cands if -euler_to_matrix(c)[:, 2] @ u[t] >= best_cos[t] - 0.02] or cands[:1]
+        out[t] = ok[0] if last is None else min(ok, key=lambda c: float(np.abs(c - last).sum()))
+        last = out[t]
+    return out
+
+
+def _other_triple(e: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """The other Euler triple of the rotation `e` (3,), shifted by full turns into `lim` (3, 2) where it fits, clipped."""
+    o = np.angle(np.exp(1j * np.array([e[0] + np.pi, np.pi - e[1], e[2] + np.pi])))
+    o = np.where(o < lim[:, 0], o + 2 * np.pi, np.where(o > lim[:, 1], o - 2 * np.pi, o))
+    return np.clip(o, lim[:, 0], lim[:, 1])
+

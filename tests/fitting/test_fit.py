@@ -205,3 +205,27 @@ def test_2d_landmarks_alone_are_lifted_to_a_plausible_pose(scene, synth):
     # Reprojection is faithful whatever the depth: the fit explains the image.
     proj = cam.project(res.joints[:, joint_index("right_wrist")])
     assert np.median(np.linalg.norm(proj - xy[:, 16], axis=1)) < 2.0
+
+
+def test_arms_lowered_from_overhead_to_the_side_keep_one_branch(synth):
+    # h4's port de bras: arms raised forward to overhead, then opened to the
+    # side (rx 164° -> 90° with rz -90°).  Chosen frame by frame, the
+    # starting angles jumped to the other Euler triple / another twist as
+    # the elbow straightened, and the solve between the two branches pointed
+    # the arm 15-35° off for a beat.
+    body = Body()
+    n = 50
+    s = np.linspace(0.0, 1.0, n)[:, None]
+    ang, root = synth.held_pose(n, body)
+    ang[:, joint_index("right_shoulder")] = np.radians(np.array([164.0, 0.0, -91.0]) * (1 - s)
+                                                       + np.array([90.0, -30.0, -90.0]) * s)
+    ang[:, joint_index("left_shoulder")] = ang[:, joint_index("right_shoulder")] * [1.0, -1.0, -1.0]
+    # Slightly bent at the top, straight from a third of the way down.
+    ang[:, joint_index("right_elbow"), 0] = ang[:, joint_index("left_elbow"), 0] = np.radians(
+        np.clip(20.0 - 60.0 * s[:, 0], 0.0, None))
+    ang = body.clip(ang)
+    cam = Camera.default((640, 480))
+    xy, conf, world, truth = synth.observe(ang, root, cam, body)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    errors = synth.limb_direction_errors(res.joints, truth)
+    assert np.max(errors) < 3.0
