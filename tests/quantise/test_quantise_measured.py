@@ -357,3 +357,29 @@ def test_a_foot_floating_out_of_contact_frees_no_foot():
     for seed in (0, 1):
         noisy = joints + _correlated(joints.shape, 0.004, seed)
         assert _supports(segment_motion(noisy, FPS, tempo=tempo).score) == [], seed
+
+
+PLIE_TO_RELEVE = """\
+title: rise from a plie to a releve and sink back
+tempo: 66
+meter: 4
+0  2   support  place  low
+2  2   support  place  high
+4  2   support  place  low
+6  2   support  place  middle
+"""
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_rise_from_plie_to_releve_passes_through_middle_without_writing_it(seed):
+    """From plié to relevé the knees straighten before the heels rise: the
+    support state passes through middle for about 0.4 s, which wrote a
+    middle support between the low and the high one (h4 and h8 of the
+    held-out phrases, even from perfect keypoints)."""
+    score, joints = _interpret(PLIE_TO_RELEVE)
+    noisy = joints + _correlated(joints.shape, 0.004, seed)
+    sup = _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)
+    assert [(p, d, lv) for _, _, p, d, lv in sup] == [
+        ("support", "place", "low"), ("support", "place", "high"), ("support", "place", "low"),
+        ("support", "place", "middle")], sup
+    assert all(abs(s - w) <= F(1, 2) for (s, *_), w in zip(sup, (0, 2, 4, 6))), sup
