@@ -335,7 +335,9 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         return b - a + 1 >= min_len or (b == T - 1 and p == 0)
 
     runs = [r for r in _runs(code) if held(*r)]
-    runs = _feet_that_stay_down(runs, _lifted(labels.supporting, smooth, fps), min_len)
+    lifted = _lifted(labels.supporting, smooth, fps)
+    runs = _feet_that_stay_down(runs, lifted, min_len)
+    runs = _no_touch_downs(runs, lifted, min_len)
     runs, passed = _without_passages(runs, smooth[:, joint_index("pelvis"), 2], fps)
     height = _body_height(smooth)
     offset = _standing_foot_offset(smooth, labels.supporting)
@@ -506,6 +508,28 @@ def _feet_that_stay_down(runs: list, lifted: np.ndarray, min_len: int) -> list:
         elif np.all(np.asarray(lifted[since : b + 1], bool).sum(axis=0) < min_len):
             c = _state_code(0, level)
         out.append((c, a, b))
+    return out
+
+
+def _no_touch_downs(runs: list, lifted: np.ndarray, min_len: int) -> list:
+    """A run on one foot between two on the other, which never left the floor, stays on the other.
+
+    A low leg gesture passing by the standing foot (forward low to right
+    low) touches the floor, and a fitted pelvis drifting towards it put the
+    weight on it for a fifth of a second between two runs on the standing
+    foot.  The weight cannot have gone over to the gesturing foot alone
+    while the standing foot stayed down (lifted for fewer than `min_len`
+    frames of the run, :func:`_lifted`): the run is the standing foot's.
+    """
+    out = list(runs)
+    for i in range(1, len(runs) - 1):
+        c, a, b = runs[i]
+        part, level = _state_of(c)
+        before, after = _state_of(runs[i - 1][0])[0], _state_of(runs[i + 1][0])[0]
+        if part > 0 and before == after > 0 and before != part:
+            other = before - 1  # foot index of the other one-foot support
+            if np.asarray(lifted[a : b + 1, other], bool).sum() < min_len:
+                out[i] = (_state_code(before, level), a, b)
     return out
 
 
