@@ -20,6 +20,8 @@ the two equivalent triples nearer to the joint's limits, then clipped.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..body import JOINTS, euler_to_matrix, joint_index, matrix_to_euler
@@ -191,7 +193,8 @@ def _continuous(chosen: np.ndarray, u: np.ndarray, free: np.ndarray, best_cos: n
     beat.  So where the limb is straight (`free`: its twist is not seen), the
     last frame's rotation is carried on by the shortest swing onto this
     frame's direction; and in every frame the Euler triple nearer the last
-    frame's is kept.
+    frame's is kept.  (The frame loop works on Python floats: numpy's
+    per-call cost on 3-vectors made it a fifth of the whole fit.)
 
     Parameters
     ----------
@@ -202,37 +205,106 @@ def _continuous(chosen: np.ndarray, u: np.ndarray, free: np.ndarray, best_cos: n
     free : (T,) ndarray of bool
         Frames whose twist may be carried on (straight limb, direction known).
     best_cos : (T,) ndarray
-        Cosine to `u` of the best per-frame candidate: a carried rotation
-        that the limits keep further than 0.02 below it is not used.
+        Cosine to `u` of the best per-frame candidate: a candidate that the
+        limits keep further than 0.02 below it is not used.
     lim : (3, 2) ndarray
         The joint's limits, radians.
     """
+    other = _other_triples(chosen, lim)
+    ok_chosen = np.sum(-euler_to_matrix(chosen)[..., :, 2] * u, axis=-1) >= best_cos - 0.02
+    ok_other = np.sum(-euler_to_matrix(other)[..., :, 2] * u, axis=-1) >= best_cos - 0.02
+    lim_l = lim.tolist()
     out = chosen.copy()
     last = None
-    for t in range(len(out)):
-        if not np.all(np.isfinite(u[t])):
-            continue
-        cands = [out[t]]
+    for t in np.flatnonzero(np.all(np.isfinite(u), axis=1)):
+        cands = []
         if free[t] and last is not None:
-            R = euler_to_matrix(last)
-            a = -R[:, 2]
-            axis = np.cross(a, u[t])
-            s = np.linalg.norm(axis)
-            if s > 1e-9:
-                R = _rodrigues(axis / s, np.arctan2(s, float(a @ u[t]))) @ R
-            carried = _euler_in_limits(R, lim)
-            if -euler_to_matrix(carried)[:, 2] @ u[t] >= best_cos[t] - 0.02:
-                cands = [carried]
-        cands.append(_other_triple(cands[0], lim))
-        ok = [c for c in cands if -euler_to_matrix(c)[:, 2] @ u[t] >= best_cos[t] - 0.02] or cands[:1]
-        out[t] = ok[0] if last is None else min(ok, key=lambda c: float(np.abs(c - last).sum()))
-        last = out[t]
+            ut = u[t].tolist()
+            carried = _euler_in_limits_1(_swing_from(_rotation_1(last), ut), lim_l)
+            for c in (carried, _other_triple_1(carried, lim_l)):
+                if _axis_cos(c, ut) >= best_cos[t] - 0.02:
+                    cands.append(c)
+        if not cands:
+            cands = [c.tolist() for c, ok in ((chosen[t], ok_chosen[t]), (other[t], ok_other[t])) if ok]
+            cands = cands or [chosen[t].tolist()]
+        if last is not None:
+            cands.sort(key=lambda c: sum(abs(x - y) for x, y in zip(c, last)))
+        last = cands[0]
+        out[t] = last
     return out
 
 
-def _other_triple(e: np.ndarray, lim: np.ndarray) -> np.ndarray:
-    """The other Euler triple of the rotation `e` (3,), shifted by full turns into `lim` (3, 2) where it fits, clipped."""
-    o = np.angle(np.exp(1j * np.array([e[0] + np.pi, np.pi - e[1], e[2] + np.pi])))
+def _other_triples(euler: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """The other Euler triple of each rotation (..., 3), shifted by full turns into `lim` (3, 2) where it fits, clipped."""
+    o = np.angle(np.exp(1j * np.stack([euler[..., 0] + np.pi, np.pi - euler[..., 1], euler[..., 2] + np.pi], -1)))
     o = np.where(o < lim[:, 0], o + 2 * np.pi, np.where(o > lim[:, 1], o - 2 * np.pi, o))
     return np.clip(o, lim[:, 0], lim[:, 1])
 
+
+# -- one rotation at a time, on Python floats (for the frame loop above) ------
+
+
+def _rotation_1(e) -> list:
+    """``Rz @ Ry @ Rx`` of one triple, as rows (see :func:`~capture2notation.body.euler_to_matrix`)."""
+    cx, cy, cz = math.cos(e[0]), math.cos(e[1]), math.cos(e[2])
+    sx, sy, sz = math.sin(e[0]), math.sin(e[1]), math.sin(e[2])
+    return [[cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx],
+            [sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx],
+            [-sy, cy * sx, cy * cx]]
+
+
+def _axis_cos(e, u) -> float:
+    """Cosine between the segment direction (−z column) of triple `e` and `u`."""
+    R = _rotation_1(e)
+    return -(R[0][2] * u[0] + R[1][2] * u[1] + R[2][2] * u[2])
+
+
+def _swing_from(R: list, u) -> list:
+    """`R` turned by the shortest rotation that takes its −z column onto unit `u`."""
+    a = [-R[0][2], -R[1][2], -R[2][2]]
+    axis = [a[1] * u[2] - a[2] * u[1], a[2] * u[0] - a[0] * u[2], a[0] * u[1] - a[1] * u[0]]
+    s = math.sqrt(sum(x * x for x in axis))
+    dot = a[0] * u[0] + a[1] * u[1] + a[2] * u[2]
+    if s <= 1e-9:
+        if dot > 0:
+            return R
+        # Opposite: half a turn about any axis across the segment.
+        axis = [0.0, -a[2], a[1]] if abs(a[0]) < 0.9 else [a[2], 0.0, -a[0]]
+        s = math.sqrt(sum(x * x for x in axis))
+    x, y, z = (v / s for v in axis)
+    ang = math.atan2(math.sqrt(max(0.0, 1.0 - dot * dot)), dot)
+    c, sn = math.cos(ang), math.sin(ang)
+    C = 1 - c
+    K = [[c + x * x * C, x * y * C - z * sn, x * z * C + y * sn],
+         [y * x * C + z * sn, c + y * y * C, y * z * C - x * sn],
+         [z * x * C - y * sn, z * y * C + x * sn, c + z * z * C]]
+    return [[sum(K[i][k] * R[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def _euler_in_limits_1(R: list, lim: list) -> list:
+    """:func:`_euler_in_limits` of one rotation (rows `R`, limits as nested lists)."""
+    ry = math.asin(max(-1.0, min(1.0, -R[2][0])))
+    if abs(R[2][0]) > 1 - 1e-9:  # gimbal lock: all the turn in rx (as matrix_to_euler)
+        e1 = [math.atan2(-R[1][2], R[1][1]), ry, 0.0]
+    else:
+        e1 = [math.atan2(R[2][1], R[2][2]), ry, math.atan2(R[1][0], R[0][0])]
+    best, worst = None, math.inf
+    for e in (e1, _other_triple_1(e1, None)):
+        e = _into(e, lim)
+        viol = sum(max(lo - v, 0.0) + max(v - hi, 0.0) for v, (lo, hi) in zip(e, lim))
+        if viol < worst:
+            best, worst = e, viol
+    return [min(max(v, lo), hi) for v, (lo, hi) in zip(best, lim)]
+
+
+def _other_triple_1(e, lim) -> list:
+    """The other triple of rotation `e`, wrapped to (−π, π], then (with `lim`) shifted into the limits and clipped."""
+    o = [math.remainder(v, 2 * math.pi) for v in (e[0] + math.pi, math.pi - e[1], e[2] + math.pi)]
+    if lim is None:
+        return o
+    return [min(max(v, lo), hi) for v, (lo, hi) in zip(_into(o, lim), lim)]
+
+
+def _into(e, lim) -> list:
+    """Each angle shifted by a full turn where that brings it within its limits (limits may exceed ±180°)."""
+    return [v + 2 * math.pi if v < lo else v - 2 * math.pi if v > hi else v for v, (lo, hi) in zip(e, lim)]
