@@ -23,7 +23,9 @@ With ``--keypoints render`` the fit is given the renderer's own landmarks
 (their pixels, and their positions in camera axes about the hips as world
 landmarks) in place of BlazePose's: what the fit and the quantiser make of
 perfect keypoints, which separates what perception loses from what they
-lose.  The speed is then that of fitting and quantising alone.
+lose.  ``render-world`` and ``render-2d`` replace only BlazePose's world
+landmarks or only its pixels.  The speed is then that of fitting and
+quantising alone (after BlazePose, for the mixed modes).
 """
 
 from __future__ import annotations
@@ -60,14 +62,31 @@ def render_track(truth):
                          world=world, crops=track.crops, backend="render")
 
 
-def _capture_render_keypoints(truth, tempo):
-    """Fit and quantise the renderer's own landmarks (see :func:`render_track`)."""
+def _keypoint_track(truth, keypoints: str, video: Path):
+    """The track a ``--keypoints`` mode fits: the renderer's, or BlazePose's with part of it replaced."""
+    import dataclasses
+
+    from capture2notation.keypoints import extract
+
+    perfect = render_track(truth)
+    if keypoints == "render":
+        return perfect
+    track = extract(video, progress=False)
+    if keypoints == "render-world":
+        return dataclasses.replace(track, world=perfect.world)
+    xy = np.array(track.xy, float)
+    xy[..., :2] = perfect.xy[..., :2]  # BlazePose's own image depth (column 2) stays
+    return dataclasses.replace(track, xy=xy)
+
+
+def _capture_render_keypoints(truth, tempo, keypoints: str, video: Path):
+    """Fit and quantise a ``--keypoints`` mode's track (see :func:`render_track`)."""
     from types import SimpleNamespace
 
     from capture2notation.fitting import Camera, fit_track
     from capture2notation.quantise.segment import segment_motion
 
-    motion = fit_track(render_track(truth), camera=Camera.from_truth(truth))
+    motion = fit_track(_keypoint_track(truth, keypoints, video), camera=Camera.from_truth(truth))
     seg = segment_motion(np.asarray(motion.joints), float(motion.fps), tempo=tempo)
     return SimpleNamespace(score=seg.score, motion=motion)
 
@@ -90,8 +109,9 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
     exact = compare_scores(score, from_truth.score).exact
     truth = read_truth(render / "truth.npz")
     t0 = time.perf_counter()
-    if keypoints == "render":
-        video = _capture_render_keypoints(truth, score.tempo if tempo_given else None)
+    if keypoints != "blazepose":
+        video = _capture_render_keypoints(truth, score.tempo if tempo_given else None, keypoints,
+                                          render / "video.mp4")
     else:
         video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False,
                         tempo=score.tempo if tempo_given else None,
@@ -133,8 +153,9 @@ def main() -> None:
     ap.add_argument("--explain", action="store_true", help="list the beats each phrase loses")
     ap.add_argument("--flip-test", action=argparse.BooleanOptionalAction, default=None,
                     help="BlazePose's mirrored second pass (default: capture's default)")
-    ap.add_argument("--keypoints", default="blazepose", choices=("blazepose", "render"),
-                    help="render: fit the renderer's own landmarks instead (perfect keypoints)")
+    ap.add_argument("--keypoints", default="blazepose", choices=("blazepose", "render", "render-world", "render-2d"),
+                    help="render: fit the renderer's own landmarks instead (perfect keypoints); render-world, "
+                         "render-2d: replace only BlazePose's world landmarks, or only its pixels")
     args = ap.parse_args()
     paths = sorted(args.phrases.glob("*.lab"))
     rows = []
