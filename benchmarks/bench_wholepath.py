@@ -79,7 +79,7 @@ def _keypoint_track(truth, keypoints: str, video: Path):
     return dataclasses.replace(track, xy=xy)
 
 
-def _capture_render_keypoints(truth, tempo, keypoints: str, video: Path):
+def _capture_other_keypoints(truth, tempo, keypoints: str, video: Path):
     """Fit and quantise a ``--keypoints`` mode's track (see :func:`render_track`)."""
     from types import SimpleNamespace
 
@@ -110,7 +110,7 @@ def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: boo
     truth = read_truth(render / "truth.npz")
     t0 = time.perf_counter()
     if keypoints != "blazepose":
-        video = _capture_render_keypoints(truth, score.tempo if tempo_given else None, keypoints,
+        video = _capture_other_keypoints(truth, score.tempo if tempo_given else None, keypoints,
                                           render / "video.mp4")
     else:
         video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False,

@@ -68,11 +68,8 @@ def _euler_in_limits(R: np.ndarray, lim: np.ndarray) -> np.ndarray:
     e1 = matrix_to_euler(R)
     e2 = np.stack([e1[..., 0] + np.pi, np.pi - e1[..., 1], e1[..., 2] + np.pi], -1)
     e2 = np.angle(np.exp(1j * e2))  # wrap to (-pi, pi]
-    cands = []
-    for e in (e1, e2):
-        # Also try each angle shifted by a full turn (limits may exceed +-180 deg).
-        alt = np.where(e < lim[:, 0], e + 2 * np.pi, np.where(e > lim[:, 1], e - 2 * np.pi, e))
-        cands.append(alt)
+    # Also try each angle shifted by a full turn (limits may exceed +-180 deg).
+    cands = [_shifted_into(e, lim) for e in (e1, e2)]
     viol = [np.sum(np.maximum(lim[:, 0] - c, 0) + np.maximum(c - lim[:, 1], 0), axis=-1) for c in cands]
     best = np.where((viol[0] <= viol[1])[..., None], cands[0], cands[1])
     return np.clip(best, lim[:, 0], lim[:, 1])
@@ -249,8 +246,12 @@ def _continuous(chosen: np.ndarray, u: np.ndarray, free: np.ndarray, best_cos: n
 def _other_triples(euler: np.ndarray, lim: np.ndarray) -> np.ndarray:
     """The other Euler triple of each rotation (..., 3), shifted by full turns into `lim` (3, 2) where it fits, clipped."""
     o = np.angle(np.exp(1j * np.stack([euler[..., 0] + np.pi, np.pi - euler[..., 1], euler[..., 2] + np.pi], -1)))
-    o = np.where(o < lim[:, 0], o + 2 * np.pi, np.where(o > lim[:, 1], o - 2 * np.pi, o))
-    return np.clip(o, lim[:, 0], lim[:, 1])
+    return np.clip(_shifted_into(o, lim), lim[:, 0], lim[:, 1])
+
+
+def _shifted_into(e: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """Euler angles (..., 3) each shifted by a full turn where that brings it within `lim` (3, 2)."""
+    return np.where(e < lim[:, 0], e + 2 * np.pi, np.where(e > lim[:, 1], e - 2 * np.pi, e))
 
 
 # -- one rotation at a time, on Python floats (for the frame loop above) ------
@@ -302,7 +303,7 @@ def _euler_in_limits_1(R: list, lim: list) -> list:
         e1 = [math.atan2(R[2][1], R[2][2]), ry, math.atan2(R[1][0], R[0][0])]
     best, worst = None, math.inf
     for e in (e1, _other_triple_1(e1, None)):
-        e = _into(e, lim)
+        e = _into_1(e, lim)
         viol = sum(max(lo - v, 0.0) + max(v - hi, 0.0) for v, (lo, hi) in zip(e, lim))
         if viol < worst:
             best, worst = e, viol
@@ -314,9 +315,9 @@ def _other_triple_1(e, lim) -> list:
     o = [math.remainder(v, 2 * math.pi) for v in (e[0] + math.pi, math.pi - e[1], e[2] + math.pi)]
     if lim is None:
         return o
-    return [min(max(v, lo), hi) for v, (lo, hi) in zip(_into(o, lim), lim)]
+    return [min(max(v, lo), hi) for v, (lo, hi) in zip(_into_1(o, lim), lim)]
 
 
-def _into(e, lim) -> list:
-    """Each angle shifted by a full turn where that brings it within its limits (limits may exceed ±180°)."""
+def _into_1(e, lim) -> list:
+    """:func:`_shifted_into` of one triple."""
     return [v + 2 * math.pi if v < lo else v - 2 * math.pi if v > hi else v for v, (lo, hi) in zip(e, lim)]

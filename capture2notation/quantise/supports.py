@@ -527,8 +527,8 @@ def _no_touch_downs(runs: list, lifted: np.ndarray, min_len: int) -> list:
         part, level = _state_of(c)
         before, after = _state_of(runs[i - 1][0])[0], _state_of(runs[i + 1][0])[0]
         if part > 0 and before == after > 0 and before != part:
-            other = before - 1  # foot index of the other one-foot support
-            if np.asarray(lifted[a : b + 1, other], bool).sum() < min_len:
+            standing = before - 1  # the foot of that one-foot support (0 right, 1 left)
+            if np.asarray(lifted[a : b + 1, standing], bool).sum() < min_len:
                 out[i] = (_state_code(before, level), a, b)
     return out
 
