@@ -32,6 +32,7 @@ __all__ = [
     "RELEVE_DEG",
     "FrameLabels",
     "flat_foot_pitch",
+    "foot_points",
     "label_frames",
     "support_frames",
     "with_supports",
@@ -145,6 +146,32 @@ def _foot_pitch_deg(joints: np.ndarray, side: str) -> np.ndarray:
     return np.degrees(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
 
 
+def foot_points(joints: np.ndarray) -> tuple[list, list]:
+    """Each foot's (right, left) lowest point and centre.
+
+    The lowest point is the toe (flat or on demi-pointe); the ankle stands
+    in for it when the toe is missing (``fmin`` skips NaN).
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joints, metres, z up.
+
+    Returns
+    -------
+    low : list of two (T,) ndarray
+        Height of the lowest point, metres.
+    mid : list of two (T, 3) ndarray
+        Midpoint of ankle and toe.
+    """
+    low, mid = [], []
+    for side in _SIDES:
+        ankle, toe = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
+        low.append(np.fmin(toe[:, 2], ankle[:, 2]))
+        mid.append(0.5 * (ankle + toe))
+    return low, mid
+
+
 def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0,
                    flat_pitch=None) -> tuple[np.ndarray, np.ndarray]:
     """Which feet support, and at which level, at every frame.
@@ -174,13 +201,10 @@ def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0,
     supporting = np.zeros((T, 2), bool)
     level = np.full((T, 2), -1, int)
     flat = np.full(2, _rest_foot_pitch_deg(Body())) if flat_pitch is None else np.asarray(flat_pitch, float)
+    lows, mids = foot_points(joints)
     for k, side in enumerate(_SIDES):
         ankle = joints[:, joint_index(f"{side}_ankle")]
-        toe = joints[:, joint_index(f"{side}_toe")]
-        # The lowest point of the foot is the toe (flat or on demi-pointe);
-        # the ankle stands in for it when the toe is missing.
-        low = np.fmin(toe[:, 2], ankle[:, 2]) - floor
-        mid = 0.5 * (ankle + toe)
+        low, mid = lows[k] - floor, mids[k]
         speed = np.full(T, np.nan)
         if T > 1:
             step = np.linalg.norm(np.diff(mid, axis=0), axis=-1) * fps

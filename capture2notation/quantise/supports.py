@@ -48,7 +48,7 @@ from scipy.signal import savgol_filter
 from ..body import joint_index
 from ..notation.directions import bend_angle, classify_indices
 from ..notation.model import LEVELS
-from .labels import DIRECTION_NAMES, FrameLabels
+from .labels import DIRECTION_NAMES, FrameLabels, foot_points
 
 __all__ = ["MIN_GROUNDED", "MIN_PELVIS_M", "MIN_SUPPORT_S", "NOISY_POSITION_M", "STEP_MIN_FRACTION", "position_noise", "smooth_positions", "support_movements",
            "support_state", "weight_bearing"]
@@ -87,7 +87,7 @@ def weight_bearing(joints: np.ndarray, contact: np.ndarray) -> np.ndarray:
     -------
     (T, 2) ndarray of bool
     """
-    _, (fr, fl) = _feet(joints)
+    _, (fr, fl) = foot_points(joints)
     u = _fraction_along(joints[:, joint_index("pelvis"), :2], fr[:, :2], fl[:, :2])
     both = contact.all(axis=1)
     wb = contact.copy()
@@ -442,16 +442,6 @@ def _without_passages(runs: list, pelvis_z: np.ndarray, fps: float) -> tuple[lis
     return keep, passed
 
 
-def _feet(joints: np.ndarray) -> tuple[list, list]:
-    """Each foot's (right, left) lowest point height (T,) and centre (T, 3): toe and ankle."""
-    low, mid = [], []
-    for side in ("right", "left"):
-        a, t = joints[:, joint_index(f"{side}_ankle")], joints[:, joint_index(f"{side}_toe")]
-        low.append(np.fmin(a[:, 2], t[:, 2]))
-        mid.append(0.5 * (a + t))
-    return low, mid
-
-
 def _lifted(contact: np.ndarray, joints: np.ndarray, fps: float) -> np.ndarray:
     """(T, 2) feet off the floor that are lifted or moving, not floating by a fit's error.
 
@@ -463,7 +453,7 @@ def _lifted(contact: np.ndarray, joints: np.ndarray, fps: float) -> np.ndarray:
     """
     from .labels import SUPPORT_SPEED_MS
 
-    low, mid = _feet(joints)
+    low, mid = foot_points(joints)
     out = ~np.asarray(contact, bool)
     for k in range(2):
         step = np.linalg.norm(np.diff(mid[k][:, :2], axis=0), axis=-1) * fps
@@ -648,7 +638,7 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
     if sup.shape[0] < 2:
         return labels
     pelvis = joints[:, joint_index("pelvis"), :2]
-    low, mid = _feet(joints)
+    low, mid = foot_points(joints)
     u = _fraction_along(pelvis, mid[0][:, :2], mid[1][:, :2])
     between = (u > OVER_FOOT_FRACTION) & (u < 1.0 - OVER_FOOT_FRACTION)
     out = sup.copy()
