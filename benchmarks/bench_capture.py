@@ -18,7 +18,7 @@ Prints (never asserts):
    frames per second of the whole capture, tempo given and estimated.
 
 :func:`score_agreement` is the reusable metric (it wraps
-:func:`capture2notation.quantise.agreement.compare_scores`).
+:func:`capture2notation.compare.agreement.compare_scores`).
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from capture2notation.compare.agreement import compare_scores, score_differences
 from capture2notation.notation.model import Score
-from capture2notation.quantise.agreement import compare_scores, score_differences
 from capture2notation.quantise.segment import segment_motion
 
 
@@ -151,8 +151,18 @@ def bench_truth(n_random: int, seed: int, fps: float = 25.0, show: int = 3) -> N
     rows = [("built-in phrases", list(builtin_phrases().items()))]
     for label, (parts, split) in FAMILIES.items() if n_random > 0 else ():
         rng = np.random.default_rng(seed)
-        rows.append((label, [(f"{label} #{i}", random_score(rng, n_beats=8, parts=parts, split_arms=split,
-                                                            random_effort=bool(i % 2))) for i in range(n_random)]))
+        rows.append(
+            (
+                label,
+                [
+                    (
+                        f"{label} #{i}",
+                        random_score(rng, n_beats=8, parts=parts, split_arms=split, random_effort=bool(i % 2)),
+                    )
+                    for i in range(n_random)
+                ],
+            )
+        )
     print(f"truth round trip at {fps:g} fps (tempo given; half the random scores with a random Effort)")
     total_frames, total_s = 0, 0.0
     for label, scores in rows:
@@ -160,10 +170,14 @@ def bench_truth(n_random: int, seed: int, fps: float = 25.0, show: int = 3) -> N
         total_frames += frames
         total_s += secs
         n = len(scores)
-        print(f"  {label:42s} exact {exact:3d}/{n} = {100 * exact / n:5.1f} %   agreement {100 * agree:5.1f} %   "
-              f"estimated tempo right {tempo_ok['right']}/{n}, equivalent {tempo_ok['equivalent']}, "
-              f"wrong {tempo_ok['wrong']}")
-        print(f"      the dancer reaches every written pose in {n - missed}/{n}; of those, exact {exact_reached}/{n - missed}")
+        print(
+            f"  {label:42s} exact {exact:3d}/{n} = {100 * exact / n:5.1f} %   agreement {100 * agree:5.1f} %   "
+            f"estimated tempo right {tempo_ok['right']}/{n}, equivalent {tempo_ok['equivalent']}, "
+            f"wrong {tempo_ok['wrong']}"
+        )
+        print(
+            f"      the dancer reaches every written pose in {n - missed}/{n}; of those, exact {exact_reached}/{n - missed}"
+        )
         for name, diffs in failures[:show]:
             print(f"      {name}: " + "; ".join(diffs[:3]))
     print(f"  quantisation speed: {total_frames / total_s:,.0f} frames/s ({total_frames} frames)")
@@ -173,7 +187,7 @@ def bench_noisy(n_random: int, seed: int, sigmas=(0.01, 0.02), fps: float = 25.0
     """Truth joints plus seeded Gaussian jitter: robustness of timing, tempo and symbols."""
     import warnings
 
-    from capture2notation.quantise.agreement import normalise
+    from capture2notation.compare.agreement import normalise
     from synthetic.interpret import interpret
     from synthetic.phrases import builtin_phrases
     from synthetic.random_scores import random_score
@@ -181,14 +195,15 @@ def bench_noisy(n_random: int, seed: int, sigmas=(0.01, 0.02), fps: float = 25.0
     warnings.simplefilter("ignore")
     rng = np.random.default_rng(seed)
     scores = list(builtin_phrases().items()) + [
-        (f"random #{i}", random_score(rng, n_beats=8, random_effort=bool(i % 2))) for i in range(n_random)]
+        (f"random #{i}", random_score(rng, n_beats=8, random_effort=bool(i % 2))) for i in range(n_random)
+    ]
     motions = [(name, score, interpret(score, fps=fps).joints()) for name, score in scores]
     print(f"noisy truth: {len(scores)} scores (3 built-ins, {n_random} full random), jitter per joint coordinate")
     for sigma in sigmas:
         for given in (True, False):
             agree, starts, verdicts, frames, secs = [], [], {"right": 0, "equivalent": 0, "wrong": 0}, 0, 0.0
             n_ref = n_missing = n_extra = 0
-            for k, (name, score, joints) in enumerate(motions):
+            for k, (_name, score, joints) in enumerate(motions):
                 noisy = joints + np.random.default_rng(seed + k).normal(0.0, sigma, joints.shape)
                 t0 = time.perf_counter()
                 seg = segment_motion(noisy, fps, tempo=score.tempo if given else None)
@@ -205,12 +220,20 @@ def bench_noisy(n_random: int, seed: int, sigmas=(0.01, 0.02), fps: float = 25.0
                 if not given:
                     ref_diffs = score_differences(score, segment_motion(noisy, fps, tempo=score.tempo).score)
                     verdicts[tempo_verdict(score, seg, ref_diffs)] += 1
-            tempo = "given" if given else (f"estimated: right {verdicts['right']}, equivalent "
-                                           f"{verdicts['equivalent']}, wrong {verdicts['wrong']}")
+            tempo = (
+                "given"
+                if given
+                else (
+                    f"estimated: right {verdicts['right']}, equivalent "
+                    f"{verdicts['equivalent']}, wrong {verdicts['wrong']}"
+                )
+            )
             print(f"  {100 * sigma:.0f} cm, tempo {tempo}")
-            print(f"      agreement {100 * np.mean(agree):5.1f} %, median start error {np.nanmedian(starts):.3f} beats, "
-                  f"symbols exact {100 * (1 - n_missing / n_ref):.1f} %, extra {n_extra / n_ref:.2f} per written symbol, "
-                  f"{frames / secs:,.0f} frames/s")
+            print(
+                f"      agreement {100 * np.mean(agree):5.1f} %, median start error {np.nanmedian(starts):.3f} beats, "
+                f"symbols exact {100 * (1 - n_missing / n_ref):.1f} %, extra {n_extra / n_ref:.2f} per written symbol, "
+                f"{frames / secs:,.0f} frames/s"
+            )
 
 
 def bench_video(k: int, seed: int, backend: str, view: str, size=(640, 480)) -> None:
@@ -228,24 +251,35 @@ def bench_video(k: int, seed: int, backend: str, view: str, size=(640, 480)) -> 
             d = Path(tmp) / f"s{i}"
             render_score(score, d, fps=25.0, size=size, view=view, style=style, progress=False)
             t0 = time.perf_counter()
-            res = capture(d / "video.mp4", d / "cap", backend=backend, tempo=score.tempo, progress=False,
-                          effort=False, overlay=False)
+            res = capture(
+                d / "video.mp4",
+                d / "cap",
+                backend=backend,
+                tempo=score.tempo,
+                progress=False,
+                effort=False,
+                overlay=False,
+            )
             dt = time.perf_counter() - t0
             a = score_agreement(score, res.score)
             # The same fitted joints with the tempo estimated (compared in time).
             est = segment_motion(np.asarray(res.motion.joints), float(res.motion.fps))
             b = score_agreement(score, est.score)
             rows.append((a, res.n_frames, dt, b, est.tempo == score.tempo))
-            print(f"  score {i}: agreement {a['symbol_agreement']:.3f}, median start error "
-                  f"{a['median_start_error']:.3f} beats, {a['unmatched']} unmatched, {res.n_frames / dt:.1f} frames/s; "
-                  f"estimated tempo {est.tempo} (written {score.tempo}): agreement {b['symbol_agreement']:.3f}")
+            print(
+                f"  score {i}: agreement {a['symbol_agreement']:.3f}, median start error "
+                f"{a['median_start_error']:.3f} beats, {a['unmatched']} unmatched, {res.n_frames / dt:.1f} frames/s; "
+                f"estimated tempo {est.tempo} (written {score.tempo}): agreement {b['symbol_agreement']:.3f}"
+            )
     fps = sum(r[1] for r in rows) / sum(r[2] for r in rows)
     print(f"whole capture ({backend}, {view}, {size[0]}x{size[1]}, {k} random scores)")
     for label, col in (("tempo given", 0), ("tempo estimated", 3)):
         agree = np.mean([r[col]["symbol_agreement"] for r in rows])
         starts = np.nanmedian([r[col]["median_start_error"] for r in rows])
-        print(f"  {label}: symbol agreement (direction + level per part per beat) {100 * agree:.1f} %, "
-              f"median start-time error {starts:.3f} beats")
+        print(
+            f"  {label}: symbol agreement (direction + level per part per beat) {100 * agree:.1f} %, "
+            f"median start-time error {starts:.3f} beats"
+        )
     print(f"  estimated tempo right in {sum(r[4] for r in rows)}/{k}")
     print(f"  speed: {fps:.1f} frames/s (render excluded)")
 

@@ -41,8 +41,8 @@ from capture2notation.effort import (
     write_effort,
 )
 from capture2notation.effort.estimate import movement_windows
-from capture2notation.effort.testing import arc_motion, random_arm_score
 from capture2notation.notation.model import Effort, Score
+from synthetic.arcs import arc_motion, random_arm_score
 
 try:
     from synthetic.interpret import interpret
@@ -81,18 +81,26 @@ def bench_posterior(n: int, seed: int = 0, ar1: bool = True) -> None:
     walls, cpus = np.array(walls), np.array(cpus)
     ok = np.array(conv)
     print(f"== movement posterior ({len(curves)} movements, {curves[0].tau.size} frames each) ==")
-    print(f"  one at a time: converged {ok.sum()}/{ok.size}; steps median {np.median(steps):.0f}; "
-          f"max tau median {np.median(taus):.1f}")
-    print(f"    seconds per converged posterior: wall median {np.median(walls[ok]):.3f} s, "
-          f"CPU median {np.median(cpus[ok]):.3f} s (aim <= 0.2 s)")
+    print(
+        f"  one at a time: converged {ok.sum()}/{ok.size}; steps median {np.median(steps):.0f}; "
+        f"max tau median {np.median(taus):.1f}"
+    )
+    print(
+        f"    seconds per converged posterior: wall median {np.median(walls[ok]):.3f} s, "
+        f"CPU median {np.median(cpus[ok]):.3f} s (aim <= 0.2 s)"
+    )
     w0, c0 = time.perf_counter(), time.process_time()
     posts = sample_posteriors([(c.tau, c.s, c.weight, None) for c in curves], rng=rng, ar1=ar1)
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
     n_ok = sum(p.converged for p in posts)
-    print(f"  all {len(curves)} in one vectorised run: converged {n_ok}/{len(posts)}; "
-          f"steps median {np.median([p.steps for p in posts]):.0f}, max {max(p.steps for p in posts)}")
-    print(f"    seconds per converged posterior: wall {wall / max(n_ok, 1):.3f} s, CPU {cpu / max(n_ok, 1):.3f} s "
-          f"(total {wall:.2f} s wall)")
+    print(
+        f"  all {len(curves)} in one vectorised run: converged {n_ok}/{len(posts)}; "
+        f"steps median {np.median([p.steps for p in posts]):.0f}, max {max(p.steps for p in posts)}"
+    )
+    print(
+        f"    seconds per converged posterior: wall {wall / max(n_ok, 1):.3f} s, CPU {cpu / max(n_ok, 1):.3f} s "
+        f"(total {wall:.2f} s wall)"
+    )
 
 
 def sixty_second_phrase(seed: int = 1, tempo: int = 60) -> Score:
@@ -120,13 +128,17 @@ def bench_phrase(workers: int, seed: int = 1, ar1: bool = True) -> None:
         n_post = len(res.movements) + len(res.parts) + 1
         conv = sum(m.posterior.converged for m in res.movements)
         pooled_conv = res.pooled.posterior.converged and all(p.posterior.converged for p in res.parts.values())
-        print(f"== 60-second phrase: {len(res.movements)} movements ({conv} converged) + "
-              f"{n_post - len(res.movements)} pooled posteriors ({'all' if pooled_conv else 'NOT all'} converged), "
-              f"{w} worker(s) ==")
+        print(
+            f"== 60-second phrase: {len(res.movements)} movements ({conv} converged) + "
+            f"{n_post - len(res.movements)} pooled posteriors ({'all' if pooled_conv else 'NOT all'} converged), "
+            f"{w} worker(s) =="
+        )
         cpu = time.process_time() - c0 + child_cpu
         print(f"  wall {wall:.1f} s (aim <= 30 s on 2 cores); CPU {cpu:.1f} s in all")
-    print(f"  pooled phrase: b {res.pooled.posterior.summary(0)['median']:.3f} (truth -2.42), "
-          f"x0 {res.pooled.posterior.summary(1)['median']:.3f} (0.6), S {res.pooled.space.median:.2f} (0)")
+    print(
+        f"  pooled phrase: b {res.pooled.posterior.summary(0)['median']:.3f} (truth -2.42), "
+        f"x0 {res.pooled.posterior.summary(1)['median']:.3f} (0.6), S {res.pooled.space.median:.2f} (0)"
+    )
 
 
 def bench_capture(folder: str, seed: int = 0) -> None:
@@ -139,17 +151,28 @@ def bench_capture(folder: str, seed: int = 0) -> None:
     cap = load_capture(Path(folder) / "capture.npz")
     score = read(Path(folder) / "score.lab")
     w0, c0 = time.perf_counter(), time.process_time()
-    res = estimate_effort(cap["joints"], cap["confidence"], cap["fps"], score, rng=np.random.default_rng(seed),
-                          times=cap["times"], joint_names=cap["joint_names"])
+    res = estimate_effort(
+        cap["joints"],
+        cap["confidence"],
+        cap["fps"],
+        score,
+        rng=np.random.default_rng(seed),
+        times=cap["times"],
+        joint_names=cap["joint_names"],
+    )
     w1, c1 = time.perf_counter(), time.process_time()
     with tempfile.TemporaryDirectory() as out:
         write_effort(res, out, plots=True, rng=seed)
     w2, c2 = time.perf_counter(), time.process_time()
     conv = sum(m.posterior.converged for m in res.movements)
-    print(f"== capture {folder}: {len(cap['times'])} frames, {len(res.movements)} movements ({conv} converged) "
-          f"+ {len(res.parts) + (res.pooled is not None)} pooled ==")
-    print(f"  estimate {w1 - w0:.2f} s wall ({c1 - c0:.2f} s CPU); effort.json + plots {w2 - w1:.2f} s wall "
-          f"({c2 - c1:.2f} s CPU, incl. importing matplotlib); Effort step {w2 - w0:.2f} s")
+    print(
+        f"== capture {folder}: {len(cap['times'])} frames, {len(res.movements)} movements ({conv} converged) "
+        f"+ {len(res.parts) + (res.pooled is not None)} pooled =="
+    )
+    print(
+        f"  estimate {w1 - w0:.2f} s wall ({c1 - c0:.2f} s CPU); effort.json + plots {w2 - w1:.2f} s wall "
+        f"({c2 - c1:.2f} s CPU, incl. importing matplotlib); Effort step {w2 - w0:.2f} s"
+    )
 
 
 def main(argv=None):
@@ -159,8 +182,10 @@ def main(argv=None):
     ap.add_argument("--capture", help="A capture folder (capture.npz + score.lab) to time the Effort step on.")
     ap.add_argument("--white", action="store_true", help="Independent residuals instead of AR(1).")
     a = ap.parse_args(argv)
-    print(f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs'}; "
-          f"residuals: {'white' if a.white else 'AR(1)'}; load average {os.getloadavg()[0]:.1f} (2 cores, shared)")
+    print(
+        f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs'}; "
+        f"residuals: {'white' if a.white else 'AR(1)'}; load average {os.getloadavg()[0]:.1f} (2 cores, shared)"
+    )
     bench_posterior(a.n, ar1=not a.white)
     bench_phrase(a.workers, ar1=not a.white)
     if a.capture:

@@ -52,8 +52,10 @@ def bench_jobs() -> None:
     scores = builtin_scores()
     comp = phrase_complexity(scores)
     conds = build_conditions(cfg)
-    n_jobs = {mode: len(build_jobs(cfg, sorted(scores), comp, [c for c in conds if c.compression == 0]))
-              for mode in ("truth", "keypoints")}
+    n_jobs = {
+        mode: len(build_jobs(cfg, sorted(scores), comp, [c for c in conds if c.compression == 0]))
+        for mode in ("truth", "keypoints")
+    }
     cores = os.cpu_count() or 1
     for mode in ("truth", "keypoints"):
         secs = []
@@ -63,12 +65,16 @@ def bench_jobs() -> None:
                 t = time.perf_counter()
                 row = run_condition(job, 0, mode, bootstrap=cfg.bootstrap)
                 secs.append(time.perf_counter() - t)
-                print(f"  {mode:9s} {name:13s} {emotion:5s} {secs[-1]:6.2f} s  symbols {row.get('symbol_accuracy', float('nan')):.2f}"
-                      f"  angle err {row.get('angle_error_deg', float('nan')):5.1f} deg  MPJPE {row.get('mpjpe_mm', float('nan')):6.1f} mm"
-                      f"  {row['error']}")
+                print(
+                    f"  {mode:9s} {name:13s} {emotion:5s} {secs[-1]:6.2f} s  symbols {row.get('symbol_accuracy', float('nan')):.2f}"
+                    f"  angle err {row.get('angle_error_deg', float('nan')):5.1f} deg  MPJPE {row.get('mpjpe_mm', float('nan')):6.1f} mm"
+                    f"  {row['error']}"
+                )
         mean = float(np.mean(secs))
-        print(f"{mode}: {mean:.2f} s per job; full default study = {n_jobs[mode]} jobs -> "
-              f"ESTIMATED {n_jobs[mode] * mean / cores / 60:.1f} min on {cores} cores (load: {os.getloadavg()[0]:.1f})")
+        print(
+            f"{mode}: {mean:.2f} s per job; full default study = {n_jobs[mode]} jobs -> "
+            f"ESTIMATED {n_jobs[mode] * mean / cores / 60:.1f} min on {cores} cores (load: {os.getloadavg()[0]:.1f})"
+        )
 
 
 def bench_quick_study() -> None:
@@ -79,8 +85,10 @@ def bench_quick_study() -> None:
         res = run_fidelity_study(load_config(), d, is_quick=True, progress=False)
         wall = time.perf_counter() - t
         base = next(e for e in res.summary["experiment1"] if e["factor"] == "baseline")
-        print(f"quick study: {res.summary['jobs']['total']} jobs in {wall:.0f} s (MEASURED); observer at baseline "
-              f"{base['percent_correct']:.1f} % correct (experts 78.70 %)")
+        print(
+            f"quick study: {res.summary['jobs']['total']} jobs in {wall:.0f} s (MEASURED); observer at baseline "
+            f"{base['percent_correct']:.1f} % correct (experts 78.70 %)"
+        )
 
 
 def main() -> None:

@@ -43,10 +43,13 @@ import numpy as np
 
 from capture2notation.body import joint_index
 from capture2notation.fitting import Camera, fit_keypoints, fit_track
-from capture2notation.io.motion import read_motion
+from capture2notation.fitting.motion import read_motion
 
-_LIMBS = [(f"{s}_{a}", f"{s}_{b}") for s in ("right", "left")
-          for a, b in (("shoulder", "elbow"), ("elbow", "wrist"), ("hip", "knee"), ("knee", "ankle"))]
+_LIMBS = [
+    (f"{s}_{a}", f"{s}_{b}")
+    for s in ("right", "left")
+    for a, b in (("shoulder", "elbow"), ("elbow", "wrist"), ("hip", "knee"), ("knee", "ankle"))
+]
 
 
 def errors(joints: np.ndarray, truth: np.ndarray, confidence: np.ndarray | None = None):
@@ -157,7 +160,11 @@ def label_agreement(joints: np.ndarray, truth: np.ndarray, fps: float, confidenc
             sel = dt >= 0
             kinds = disagreement_kinds(dt[sel], ltv[sel], df[sel], lfv[sel])
             a, b = (joint_index(n) for n in PART_SEGMENTS[part])
-            conf = np.full(kinds.shape, np.nan) if confidence is None else np.minimum(confidence[sel, a], confidence[sel, b])
+            conf = (
+                np.full(kinds.shape, np.nan)
+                if confidence is None
+                else np.minimum(confidence[sel, a], confidence[sel, b])
+            )
         else:
             ok = (dt == df) & (ltv == lfv)
             kinds = np.where(ok, "ok", "support").astype(object)
@@ -211,8 +218,10 @@ def label_benchmark(seeds, views, cache: Path | None, phrases: bool = True) -> N
         parts, kinds, calib = defaultdict(list), Counter(), []
         frames, cpu, mp, med, p90, root_err = 0, 0.0, [], [], [], []
         print(f"\n== view {view}")
-        print(f"{'clip':14s} {'frames':>6s} {'MPJPE cm':>8s} {'med deg':>7s} {'p90 deg':>7s} {'gesture %':>9s} "
-              f"{'support %':>9s} {'root cm':>7s} {'fit fps':>7s}")
+        print(
+            f"{'clip':14s} {'frames':>6s} {'MPJPE cm':>8s} {'med deg':>7s} {'p90 deg':>7s} {'gesture %':>9s} "
+            f"{'support %':>9s} {'root cm':>7s} {'fit fps':>7s}"
+        )
         for name, score in clips.items():
             track, truth = _track_and_truth(name, score, view, cache)
             res, c, _ = timed(fit_track, track, camera=Camera.from_truth(truth))
@@ -229,8 +238,10 @@ def label_benchmark(seeds, views, cache: Path | None, phrases: bool = True) -> N
             T = len(track.times)
             frames, cpu = frames + T, cpu + c
             mp.append(m), med.append(md), p90.append(p9), root_err.append(rerr)
-            print(f"{name:14s} {T:6d} {m * 100:8.1f} {md:7.1f} {p9:7.1f} {gest * 100:9.1f} {sup * 100:9.1f} "
-                  f"{rerr * 100:7.1f} {T / c:7.0f}")
+            print(
+                f"{name:14s} {T:6d} {m * 100:8.1f} {md:7.1f} {p9:7.1f} {gest * 100:9.1f} {sup * 100:9.1f} "
+                f"{rerr * 100:7.1f} {T / c:7.0f}"
+            )
 
         def pooled(part, parts=parts):  # frame-weighted over clips
             a = np.array(parts[part])
@@ -238,26 +249,38 @@ def label_benchmark(seeds, views, cache: Path | None, phrases: bool = True) -> N
 
         gest = np.mean([pooled(p) for p in PART_SEGMENTS])
         sup = np.mean([pooled(p) for p in ("support", "right_support", "left_support")])
-        print(f"{view}: {frames} frames, fit {frames / cpu:.0f} frames/CPU-s; mean over clips: MPJPE "
-              f"{np.mean(mp) * 100:.1f} cm, median limb error {np.mean(med):.1f} deg (p90 {np.mean(p90):.1f}), "
-              f"root error {np.mean(root_err) * 100:.1f} cm; label agreement: gestures {gest * 100:.1f} %, "
-              f"supports {sup * 100:.1f} %")
+        print(
+            f"{view}: {frames} frames, fit {frames / cpu:.0f} frames/CPU-s; mean over clips: MPJPE "
+            f"{np.mean(mp) * 100:.1f} cm, median limb error {np.mean(med):.1f} deg (p90 {np.mean(p90):.1f}), "
+            f"root error {np.mean(root_err) * 100:.1f} cm; label agreement: gestures {gest * 100:.1f} %, "
+            f"supports {sup * 100:.1f} %"
+        )
         print("  per part: " + "  ".join(f"{p} {pooled(p) * 100:.0f}" for p in parts))
         cal = np.concatenate(calib)
         bins = ((0.0, 0.25), (0.25, 0.5), (0.5, 0.75), (0.75, 1.01))
-        print("  gesture agreement by the fit's confidence: " + ", ".join(
-            f"[{lo:.2f},{min(hi, 1):.2f}) {np.mean(cal[(cal[:, 0] >= lo) & (cal[:, 0] < hi), 1]) * 100:.0f} % "
-            f"of {np.sum((cal[:, 0] >= lo) & (cal[:, 0] < hi))}" for lo, hi in bins if np.any((cal[:, 0] >= lo) & (cal[:, 0] < hi))))
+        print(
+            "  gesture agreement by the fit's confidence: "
+            + ", ".join(
+                f"[{lo:.2f},{min(hi, 1):.2f}) {np.mean(cal[(cal[:, 0] >= lo) & (cal[:, 0] < hi), 1]) * 100:.0f} % "
+                f"of {np.sum((cal[:, 0] >= lo) & (cal[:, 0] < hi))}"
+                for lo, hi in bins
+                if np.any((cal[:, 0] >= lo) & (cal[:, 0] < hi))
+            )
+        )
         total = sum(kinds.values())
-        print("  disagreements: " + ", ".join(f"{k} {kinds[k]} ({kinds[k] / max(total, 1) * 100:.0f} %)"
-                                              for k in _CATEGORIES if kinds[k]))
+        print(
+            "  disagreements: "
+            + ", ".join(f"{k} {kinds[k]} ({kinds[k] / max(total, 1) * 100:.0f} %)" for k in _CATEGORIES if kinds[k])
+        )
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--blazepose", action="store_true", help="also render the front view and run BlazePose")
     ap.add_argument("--labels", action="store_true", help="label agreement through BlazePose (see above)")
-    ap.add_argument("--seeds", type=int, nargs="*", default=list(range(6)), help="seeds of the random scores in --labels")
+    ap.add_argument(
+        "--seeds", type=int, nargs="*", default=list(range(6)), help="seeds of the random scores in --labels"
+    )
     ap.add_argument("--no-phrases", action="store_true", help="leave the built-in phrases out of --labels")
     ap.add_argument("--views", nargs="+", default=["front", "45", "side"], choices=["front", "45", "side"])
     ap.add_argument("--cache", type=Path, default=None, help="folder keeping rendered tracks for --labels")
@@ -274,8 +297,10 @@ def main() -> None:
     rng = np.random.default_rng(0)
     print("Fitting accuracy from the truth's 2D keypoints + world landmarks (640x480)")
     print("all joints | only joints the fit is confident about (>= 0.5; self-occluded landmarks have visibility 0)")
-    print(f"{'phrase':14s} {'view':5s} {'noise':>12s} {'frames':>6s} {'MPJPE cm':>9s} {'med deg':>8s} {'p90 deg':>8s} "
-          f"| {'MPJPE':>6s} {'med':>5s} {'p90':>6s} {'fps cpu':>8s} {'fps wall':>8s}")
+    print(
+        f"{'phrase':14s} {'view':5s} {'noise':>12s} {'frames':>6s} {'MPJPE cm':>9s} {'med deg':>8s} {'p90 deg':>8s} "
+        f"| {'MPJPE':>6s} {'med':>5s} {'p90':>6s} {'fps cpu':>8s} {'fps wall':>8s}"
+    )
     total_frames, total_cpu = 0, 0.0
     poses = {}
     for name in PHRASE_NAMES:
@@ -295,27 +320,46 @@ def main() -> None:
                 total_frames += T
                 total_cpu += cpu
                 label = f"{noise_px:g}px/{noise_m * 100:g}cm"
-                print(f"{name:14s} {view:5s} {label:>12s} {T:6d} {m * 100:9.2f} {med:8.2f} {p90:8.2f} "
-                      f"| {mc * 100:6.2f} {medc:5.2f} {p90c:6.2f} {T / cpu:8.0f} {T / wall:8.0f}")
+                print(
+                    f"{name:14s} {view:5s} {label:>12s} {T:6d} {m * 100:9.2f} {med:8.2f} {p90:8.2f} "
+                    f"| {mc * 100:6.2f} {medc:5.2f} {p90c:6.2f} {T / cpu:8.0f} {T / wall:8.0f}"
+                )
     print(f"overall fitting speed: {total_frames / total_cpu:.0f} frames per CPU-second")
 
-    xy, conf, world = observations(truth_fields(poses["leg_phrase"], RenderCamera.for_view("front", (640, 480))), 2.0, 0.0, rng)
-    res, cpu, wall = timed(fit_keypoints, xy, conf, 25.0, world=None,
-                           camera=Camera.from_truth(truth_fields(poses["leg_phrase"], RenderCamera.for_view("front", (640, 480)))))
+    xy, conf, world = observations(
+        truth_fields(poses["leg_phrase"], RenderCamera.for_view("front", (640, 480))), 2.0, 0.0, rng
+    )
+    res, cpu, wall = timed(
+        fit_keypoints,
+        xy,
+        conf,
+        25.0,
+        world=None,
+        camera=Camera.from_truth(truth_fields(poses["leg_phrase"], RenderCamera.for_view("front", (640, 480)))),
+    )
     m, med, p90 = errors(res.joints, poses["leg_phrase"].joints)
-    print(f"2D keypoints only (no world landmarks), leg_phrase front 2px: MPJPE {m * 100:.1f} cm, median {med:.1f} deg, p90 {p90:.1f} deg")
+    print(
+        f"2D keypoints only (no world landmarks), leg_phrase front 2px: MPJPE {m * 100:.1f} cm, median {med:.1f} deg, p90 {p90:.1f} deg"
+    )
     f = truth_fields(poses["port_de_bras"], RenderCamera.for_view("front", (640, 480)))
     xy, conf, world = observations(f, 2.0, 0.02, rng)
     res, cpu, wall = timed(fit_keypoints, xy, conf, 25.0, world=world, image_size=(640, 480))
-    rel = lambda j: j - j[:, :1]
+
+    def rel(j):
+        return j - j[:, :1]
+
     m, med, p90 = errors(rel(res.joints), rel(poses["port_de_bras"].joints))
-    print(f"unknown camera (default {Camera.default((640, 480)).focal:.0f} px focal, refined), port_de_bras front 2px: "
-          f"root-relative MPJPE {m * 100:.1f} cm, median {med:.1f} deg; {len(xy) / cpu:.0f} frames/CPU-s incl. focal search")
+    print(
+        f"unknown camera (default {Camera.default((640, 480)).focal:.0f} px focal, refined), port_de_bras front 2px: "
+        f"root-relative MPJPE {m * 100:.1f} cm, median {med:.1f} deg; {len(xy) / cpu:.0f} frames/CPU-s incl. focal search"
+    )
 
     fixtures = Path(__file__).resolve().parents[2] / "shared" / "fixtures" / "bvh"
     for bvh in sorted(fixtures.glob("*.bvh")):
         mo, cpu, wall = timed(read_motion, bvh)
-        print(f"read_motion {bvh.name}: {mo.n_frames} frames in {cpu:.1f} CPU-s ({mo.n_frames / cpu:.0f} frames/CPU-s, wall {wall:.1f} s)")
+        print(
+            f"read_motion {bvh.name}: {mo.n_frames} frames in {cpu:.1f} CPU-s ({mo.n_frames / cpu:.0f} frames/CPU-s, wall {wall:.1f} s)"
+        )
 
     if args.blazepose:
         from capture2notation.keypoints import extract
@@ -330,8 +374,10 @@ def main() -> None:
                 (track, kcpu, _) = timed(extract, video)
                 res, cpu, wall = timed(fit_track, track, camera=Camera.from_truth(truth))
                 m, med, p90 = errors(res.joints, truth.joints)
-                print(f"BlazePose {name} front 640x480: MPJPE {m * 100:.1f} cm, median {med:.1f} deg, p90 {p90:.1f} deg; "
-                      f"keypoints {len(track.times) / kcpu:.0f} fps, fit {len(track.times) / cpu:.0f} fps (CPU)")
+                print(
+                    f"BlazePose {name} front 640x480: MPJPE {m * 100:.1f} cm, median {med:.1f} deg, p90 {p90:.1f} deg; "
+                    f"keypoints {len(track.times) / kcpu:.0f} fps, fit {len(track.times) / cpu:.0f} fps (CPU)"
+                )
 
 
 if __name__ == "__main__":

@@ -122,7 +122,9 @@ def bench_fixtures(bp: BlazePose) -> None:
     est = bp.estimate_image(cv2.imread(str(mp / "pose.jpg")))
     err = np.abs(est.xy[:, :2] - np.array(exp["pixel_xy"]))
     werr = np.abs(est.world - np.array(exp["world_xyz_m"]))
-    print(f"pose.jpg: max {err.max():.1f} px (tolerance 15), median {np.median(err):.1f} px; world max {werr.max():.3f} m (tolerance 0.2)")
+    print(
+        f"pose.jpg: max {err.max():.1f} px (tolerance 15), median {np.median(err):.1f} px; world max {werr.max():.3f} m (tolerance 0.2)"
+    )
     ref = np.array(json.loads((mp / "pose_squats.full.json").read_text()))
     for smooth in (True, False):
         track = extract(mp / "pose_squats.mp4", estimator=bp, smooth=smooth)
@@ -170,14 +172,19 @@ def bench_mannequin(bp: BlazePose, fps: float) -> None:
         mode = "flip test" if bp.flip_test else "one pass"
         print(f"mannequin {view}, {mode} ({n} frames at {fps:g} fps, visible joints): PCK@5% {row}; swaps {swaps}")
         bias = {j: np.nanmean(np.concatenate(signed[j]), axis=0) for j in joints if counts.get(j)}
-        print("  mean signed error (x, y) px: " + " ".join(f"{names[j]}=({b[0]:+.1f},{b[1]:+.1f})" for j, b in bias.items()))
+        print(
+            "  mean signed error (x, y) px: "
+            + " ".join(f"{names[j]}=({b[0]:+.1f},{b[1]:+.1f})" for j, b in bias.items())
+        )
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=150, help="frames per rendered benchmark video")
     ap.add_argument("--threads", type=int, default=2, help="onnxruntime intra-op threads")
-    ap.add_argument("--mannequin-fps", type=float, default=10.0, help="frame rate of the mannequin accuracy renders (0: skip)")
+    ap.add_argument(
+        "--mannequin-fps", type=float, default=10.0, help="frame rate of the mannequin accuracy renders (0: skip)"
+    )
     args = ap.parse_args()
     bp = BlazePose(threads=args.threads)
     print(f"onnxruntime threads: {args.threads}; cpu count: {os.cpu_count()}")

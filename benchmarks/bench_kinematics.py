@@ -34,12 +34,12 @@ def main() -> None:
     for T in (1_000, 10_000, 100_000):
         angles = body.clip(rng.uniform(-1, 1, (T, len(JOINTS), 3)))
         root = np.tile(body.rest[0], (T, 1))
-        dt = _best(lambda: forward_kinematics(angles, root, body))
+        dt = _best(lambda angles=angles, root=root: forward_kinematics(angles, root, body))
         print(f"forward_kinematics  T={T:>7,}  {T / dt:>12,.0f} frames/s")
 
     for name, score in builtin_phrases().items():
         m = interpret(score, 25.0)
-        dt = _best(lambda: interpret(score, 25.0))
+        dt = _best(lambda score=score: interpret(score, 25.0))
         print(f"interpret {name:<14} {m.n_frames:>5} frames  {m.n_frames / dt:>9,.0f} frames/s")
 
     scores = [random_score(np.random.default_rng(s), n_beats=32) for s in range(5)]
@@ -49,7 +49,7 @@ def main() -> None:
         for sc in scores:
             n = interpret(sc, 25.0).n_frames
             frames += n
-            total += _best(lambda: interpret(sc, 25.0), repeats=3)
+            total += _best(lambda sc=sc: interpret(sc, 25.0), repeats=3)
     print(f"interpret random 32-beat scores  {frames:>5} frames  {frames / total:>9,.0f} frames/s")
 
     t = time.perf_counter()

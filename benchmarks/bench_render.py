@@ -42,10 +42,14 @@ def main() -> None:
     size = tuple(int(v) for v in args.size.split("x"))
     pose = _motion(args.frames)
     cam = Camera.for_view("45", size, pose.body.height)
-    print(f"{args.frames} frames at {size[0]}x{size[1]}, view 45, H.264 encoding included (ffmpeg runs as its own process: the per-CPU-second figures count this process only)")
+    print(
+        f"{args.frames} frames at {size[0]}x{size[1]}, view 45, H.264 encoding included (ffmpeg runs as its own process: the per-CPU-second figures count this process only)"
+    )
     t0 = time.perf_counter()
     truth_fields(pose, cam)
-    print(f"  truth sidecar fields (projection + visibility): {args.frames / (time.perf_counter() - t0):10.0f} frames/s")
+    print(
+        f"  truth sidecar fields (projection + visibility): {args.frames / (time.perf_counter() - t0):10.0f} frames/s"
+    )
     with tempfile.TemporaryDirectory() as tmp:
         for style in ("mannequin", "stick", "markers"):
             t0, c0 = time.perf_counter(), time.process_time()

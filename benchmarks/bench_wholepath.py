@@ -17,7 +17,7 @@ cells lost out of those compared, the median start-time error in beats, whether 
 error and MPJPE of the fit, and frames per second of the whole video capture.
 With ``--explain``, under each phrase, the beats it loses: per part, the
 reference's state and the capture's
-(:func:`capture2notation.quantise.agreement.agreement_cells`).
+(:func:`capture2notation.compare.agreement.agreement_cells`).
 
 With ``--keypoints render`` the fit is given the renderer's own landmarks
 (their pixels, and their positions in camera axes about the hips as world
@@ -57,9 +57,17 @@ def render_track(truth):
     world = camera_axes - 0.5 * (camera_axes[:, 23] + camera_axes[:, 24])[:, None]
     w, h = truth.image_size
     inside = (xy[..., 0] >= 0) & (xy[..., 0] < w) & (xy[..., 1] >= 0) & (xy[..., 1] < h)
-    return KeypointTrack(fps=truth.fps, times=truth.times, image_size=truth.image_size, xy=xy,
-                         visibility=inside.astype(float), presence=np.ones(truth.n_frames),
-                         world=world, crops=track.crops, backend="render")
+    return KeypointTrack(
+        fps=truth.fps,
+        times=truth.times,
+        image_size=truth.image_size,
+        xy=xy,
+        visibility=inside.astype(float),
+        presence=np.ones(truth.n_frames),
+        world=world,
+        crops=track.crops,
+        backend="render",
+    )
 
 
 def _keypoint_track(truth, keypoints: str, video: Path):
@@ -91,31 +99,44 @@ def _capture_other_keypoints(truth, tempo, keypoints: str, video: Path):
     return SimpleNamespace(score=seg.score, motion=motion)
 
 
-def measure(path: Path, workdir: Path, view: str, effort: bool, tempo_given: bool = False,
-            flip_test: bool | None = None, keypoints: str = "blazepose") -> dict:
+def measure(
+    path: Path,
+    workdir: Path,
+    view: str,
+    effort: bool,
+    tempo_given: bool = False,
+    flip_test: bool | None = None,
+    keypoints: str = "blazepose",
+) -> dict:
     """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
+    from capture2notation.compare.agreement import agreement_cells, compare_scores
     from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
     from capture2notation.notation.formats import read
-    from capture2notation.quantise.agreement import agreement_cells, compare_scores
     from pipelines.capture import capture
     from pipelines.commands.demo import _limb_error
     from synthetic.render import render_score
 
     score = read(path)
-    render = render_score(score, workdir / "render", fps=25.0, size=(640, 480), view=view, style="mannequin",
-                          progress=False)
+    render = render_score(
+        score, workdir / "render", fps=25.0, size=(640, 480), view=view, style="mannequin", progress=False
+    )
     from_truth = capture(render / "truth.npz", workdir / "truth", tempo=score.tempo, progress=False, effort=False)
     exact = compare_scores(score, from_truth.score).exact
     truth = read_truth(render / "truth.npz")
     t0 = time.perf_counter()
     if keypoints != "blazepose":
-        video = _capture_other_keypoints(truth, score.tempo if tempo_given else None, keypoints,
-                                          render / "video.mp4")
+        video = _capture_other_keypoints(truth, score.tempo if tempo_given else None, keypoints, render / "video.mp4")
     else:
-        video = capture(render / "video.mp4", workdir / "video", progress=False, effort=effort, overlay=False,
-                        tempo=score.tempo if tempo_given else None,
-                        **({} if flip_test is None else {"flip_test": flip_test}))
+        video = capture(
+            render / "video.mp4",
+            workdir / "video",
+            progress=False,
+            effort=effort,
+            overlay=False,
+            tempo=score.tempo if tempo_given else None,
+            **({} if flip_test is None else {"flip_test": flip_test}),
+        )
     seconds = time.perf_counter() - t0
     a = compare_scores(score, video.score)
     cells = agreement_cells(score, video.score)
@@ -151,22 +172,32 @@ def main() -> None:
     ap.add_argument("--effort", action="store_true", help="include the Effort estimate in the timed capture")
     ap.add_argument("--tempo-given", action="store_true", help="give the video capture the written tempo")
     ap.add_argument("--explain", action="store_true", help="list the beats each phrase loses")
-    ap.add_argument("--flip-test", action=argparse.BooleanOptionalAction, default=None,
-                    help="BlazePose's mirrored second pass (default: capture's default)")
-    ap.add_argument("--keypoints", default="blazepose", choices=("blazepose", "render", "render-world", "render-2d"),
-                    help="render: fit the renderer's own landmarks instead (perfect keypoints); render-world, "
-                         "render-2d: replace only BlazePose's world landmarks, or only its pixels")
+    ap.add_argument(
+        "--flip-test",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="BlazePose's mirrored second pass (default: capture's default)",
+    )
+    ap.add_argument(
+        "--keypoints",
+        default="blazepose",
+        choices=("blazepose", "render", "render-world", "render-2d"),
+        help="render: fit the renderer's own landmarks instead (perfect keypoints); render-world, "
+        "render-2d: replace only BlazePose's world landmarks, or only its pixels",
+    )
     args = ap.parse_args()
     paths = sorted(args.phrases.glob("*.lab"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for p in paths:
-            r = measure(p, Path(tmp) / p.stem, args.view, args.effort, args.tempo_given, args.flip_test,
-                        args.keypoints)
+            r = measure(p, Path(tmp) / p.stem, args.view, args.effort, args.tempo_given, args.flip_test, args.keypoints)
             rows.append(r)
-            print(f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
-                  f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
-                  f"limb {r['limb_deg']:4.1f}°  MPJPE {r['mpjpe_cm']:4.1f} cm  {r['fps']:5.1f} fps", flush=True)
+            print(
+                f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
+                f"tempo {r['tempo'][0]:g}->{r['tempo'][1]:g}  truth exact {r['truth_exact']!s:<5}  "
+                f"limb {r['limb_deg']:4.1f}°  MPJPE {r['mpjpe_cm']:4.1f} cm  {r['fps']:5.1f} fps",
+                flush=True,
+            )
             if args.explain:
                 print(_explain(r["missed"]), end="", flush=True)
     frames = sum(r["frames"] for r in rows)
@@ -177,7 +208,9 @@ def main() -> None:
     # The columns compared are the parts either score moves, so a capture
     # that writes fewer spurious symbols can lose cells *and* percentage:
     # the lost cells say which.
-    print(f"  cells lost / compared                 {sum(len(r['missed']) for r in rows)} / {sum(r['cells'] for r in rows)}")
+    print(
+        f"  cells lost / compared                 {sum(len(r['missed']) for r in rows)} / {sum(r['cells'] for r in rows)}"
+    )
     print(f"  median start error                    {np.nanmedian([r['start_error'] for r in rows]):.2f} beat")
     print(f"  truth captures exact                  {sum(r['truth_exact'] for r in rows)}/{len(rows)}")
     print(f"  median limb-direction error           {np.median([r['limb_deg'] for r in rows]):.1f}°")

@@ -41,9 +41,9 @@ from capture2notation.effort.emotion import (
     preset_features,
 )
 from capture2notation.effort.estimate import _emotion_input
-from capture2notation.effort.presets import PRESETS
-from capture2notation.effort.testing import arc_motion, random_arm_score
+from capture2notation.notation.effort import PRESETS
 from capture2notation.notation.model import Effort
+from synthetic.arcs import arc_motion, random_arm_score
 
 try:
     from synthetic.interpret import interpret
@@ -75,8 +75,11 @@ ESTIMATE_KW: dict = {}
 def _recovery_job(args):
     seed, noise, capture_fn, est_kw = args
     rng = np.random.default_rng(seed)
-    truth = Effort(time=float(rng.uniform(-4.5, -1.8)), weight=float(rng.uniform(0.3, 0.8)),
-                   space=float(rng.choice([0.0, 0.5, 1.0])))
+    truth = Effort(
+        time=float(rng.uniform(-4.5, -1.8)),
+        weight=float(rng.uniform(0.3, 0.8)),
+        space=float(rng.choice([0.0, 0.5, 1.0])),
+    )
     score = _performance(seed, truth, 60)
     if capture_fn is None:
         joints = _truth_joints(score)
@@ -92,11 +95,17 @@ def _recovery_job(args):
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     rows = []
     for m in res.movements:
-        rows.append((
-            truth.time, truth.weight, truth.space,
-            m.posterior.summary(0), m.posterior.summary(1), {"median": m.space.median, "ci90": m.space.ci90},
-            m.posterior.converged,
-        ))
+        rows.append(
+            (
+                truth.time,
+                truth.weight,
+                truth.space,
+                m.posterior.summary(0),
+                m.posterior.summary(1),
+                {"median": m.space.median, "ci90": m.space.ci90},
+                m.posterior.converged,
+            )
+        )
     return rows, wall, cpu, len(res.movements) + len(res.parts) + (res.pooled is not None)
 
 
@@ -173,14 +182,25 @@ def blazepose_capture(score, fps=FPS, size=(640, 480), view="front"):
     with tempfile.TemporaryDirectory(prefix="c2n-effort-cal-") as tmp:
         tmp = Path(tmp)
         render_score(score, tmp / "render", fps=fps, size=size, view=view, progress=False)
-        capture(tmp / "render" / "video.mp4", tmp / "capture", effort=False, overlay=False, progress=False,
-                tempo=float(score.tempo))
+        capture(
+            tmp / "render" / "video.mp4",
+            tmp / "capture",
+            effort=False,
+            overlay=False,
+            progress=False,
+            tempo=float(score.tempo),
+        )
         with np.load(tmp / "capture" / "capture.npz") as z:
             names = tuple(str(n) for n in z["joint_names"])
             if names != tuple(JOINTS):
                 raise RuntimeError(f"capture joints {names} differ from the canonical {tuple(JOINTS)}")
-            return (np.asarray(z["joints"], float), np.asarray(z["confidence"], float), float(z["fps"]),
-                    np.asarray(z["times"], float), read(tmp / "capture" / "score.lab"))
+            return (
+                np.asarray(z["joints"], float),
+                np.asarray(z["confidence"], float),
+                float(z["fps"]),
+                np.asarray(z["times"], float),
+                read(tmp / "capture" / "score.lab"),
+            )
 
 
 # --- emotion -------------------------------------------------------------------
@@ -252,7 +272,9 @@ def emotion_figures(test, spread, seed: int, trials_per_pair: int = 200):
             ok.append(same == (a == b))
         correct_all += ok
         print(f"  {a + '-' + b:<14} {100 * np.mean(ok):5.1f}% correct")
-    print(f"  overall   {100 * np.mean(correct_all):5.1f}% correct ({len(pairs)} pair types x {trials_per_pair} trials)")
+    print(
+        f"  overall   {100 * np.mean(correct_all):5.1f}% correct ({len(pairs)} pair types x {trials_per_pair} trials)"
+    )
 
 
 def main(argv=None):
@@ -262,15 +284,26 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--skip-recovery", action="store_true")
     ap.add_argument("--skip-emotion", action="store_true")
-    ap.add_argument("--blazepose", type=int, default=0, metavar="N",
-                    help="Also part 1 through render -> BlazePose -> 3D fitting on N performances (slow).")
-    ap.add_argument("--windows", choices=("truth", "captured"), default="truth",
-                    help="Through BlazePose: movement windows from the truth score or the captured (quantised) one.")
+    ap.add_argument(
+        "--blazepose",
+        type=int,
+        default=0,
+        metavar="N",
+        help="Also part 1 through render -> BlazePose -> 3D fitting on N performances (slow).",
+    )
+    ap.add_argument(
+        "--windows",
+        choices=("truth", "captured"),
+        default="truth",
+        help="Through BlazePose: movement windows from the truth score or the captured (quantised) one.",
+    )
     ap.add_argument("--no-refine", action="store_true", help="Use the score's windows as given (no refinement).")
     a = ap.parse_args(argv)
     ESTIMATE_KW.update(windows=a.windows, refine=not a.no_refine)
     n_perf, n_emo = (6, 6) if a.quick else (40, 30)
-    print(f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs (synthetic.interpret missing)'}")
+    print(
+        f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs (synthetic.interpret missing)'}"
+    )
     if not a.skip_recovery:
         recovery(n_perf, 1974, 0.0, a.workers)
         recovery(n_perf, 1974, 0.005, a.workers)
@@ -280,8 +313,10 @@ def main(argv=None):
         t0 = time.perf_counter()
         cal = emotion_set(n_emo, 2005, a.workers)
         spread = derive_spread(cal)
-        print(f"\ncalibration set (seed 2005, {len(cal)} performances): SPREAD = "
-              f"({', '.join(f'{v:.4f}' for v in spread)})  [time, weight, space, log_tempo]")
+        print(
+            f"\ncalibration set (seed 2005, {len(cal)} performances): SPREAD = "
+            f"({', '.join(f'{v:.4f}' for v in spread)})  [time, weight, space, log_tempo]"
+        )
         if not a.derive:
             from capture2notation.effort.emotion import SPREAD
 

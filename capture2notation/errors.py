@@ -7,20 +7,20 @@ expected, so a user can fix the input without reading the code.
 from __future__ import annotations
 
 __all__ = [
-    "C2NError",
     "BodyModelError",
+    "C2NError",
+    "CompareError",
+    "EffortError",
+    "FittingError",
+    "KeypointError",
+    "ModelError",
+    "MotionFileError",
     "NotationError",
+    "PipelineError",
+    "QuantiseError",
     "ScoreFormatError",
     "SyntheticError",
     "VideoError",
-    "ModelError",
-    "KeypointError",
-    "MotionFileError",
-    "FittingError",
-    "QuantiseError",
-    "EffortError",
-    "CompareError",
-    "PipelineError",
 ]
 
 

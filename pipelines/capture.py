@@ -35,9 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
+from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
 from capture2notation.errors import C2NError, PipelineError
-from capture2notation.io.atomic import atomic_path, write_text
 from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.labels import write_labels_csv
@@ -47,7 +47,7 @@ from capture2notation.quantise.segment import (
     segment_motion,
 )
 
-__all__ = ["VIDEO_SUFFIXES", "MOTION_SUFFIXES", "CaptureResult", "input_kind", "capture", "load_motion", "tempo_note"]
+__all__ = ["MOTION_SUFFIXES", "VIDEO_SUFFIXES", "CaptureResult", "capture", "input_kind", "load_motion", "tempo_note"]
 
 log = logging.getLogger(__name__)
 
@@ -130,8 +130,9 @@ def _with_fps(motion, fps: float):
     return motion.replace(fps=float(fps), times=np.arange(T) / float(fps))
 
 
-def load_motion(path, kind: str, backend: str = "blazepose", fps_override=None, progress: bool = True,
-                flip_test: bool = False):
+def load_motion(
+    path, kind: str, backend: str = "blazepose", fps_override=None, progress: bool = True, flip_test: bool = False
+):
     """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
 
     Returns
@@ -160,7 +161,7 @@ def load_motion(path, kind: str, backend: str = "blazepose", fps_override=None, 
         motion = fit_track(track, camera=camera)
         seconds["fitting"] = time.perf_counter() - t0
         return motion, track, seconds
-    from capture2notation.io.motion import read_motion
+    from capture2notation.fitting.motion import read_motion
 
     t0 = time.perf_counter()
     motion = read_motion(path)
@@ -271,9 +272,7 @@ def _write_outputs(outdir: Path, seg: Segmentation, motion, track, input_path, k
     files["score.json"] = write(score, outdir / "score.json")
     files["laban_editor.json"] = write_laban_editor(score, outdir / "laban_editor.json")
     angles = getattr(motion, "angles", None)
-    stave, poses = benesh_key_poses(
-        motion.joints, seg.key_frames, motion.fps, tempo=score.tempo, angles=angles
-    )
+    stave, poses = benesh_key_poses(motion.joints, seg.key_frames, motion.fps, tempo=score.tempo, angles=angles)
     write_benesh(outdir / "benesh.json", stave, poses, tempo=score.tempo)
     files["benesh.json"] = outdir / "benesh.json"
     write_labels_csv(seg.labels, outdir / "labels.csv")
@@ -346,8 +345,10 @@ def tempo_note(seg, kind: str | None = None) -> str:
     """
     other = f"; else {seg.tempo_runner_up} bpm" if seg.tempo_runner_up is not None else ""
     if kind == "video":
-        return (f" (estimated from the movements{other}; on video it has been right about {VIDEO_TEMPO_RIGHT} "
-                "of the time: give --tempo)")
+        return (
+            f" (estimated from the movements{other}; on video it has been right about {VIDEO_TEMPO_RIGHT} "
+            "of the time: give --tempo)"
+        )
     conf = seg.tempo_confidence
     sure = f", {conf:.0%} sure" if np.isfinite(conf) else ""
     return f" (estimated{sure}{other}; give --tempo to fix it)"
@@ -366,12 +367,17 @@ def _effort_html(files: dict) -> str:
     )
     emotion = data.get("emotion") or {}
     feelings = " · ".join(f"{html.escape(k)} {v:.0%}" for k, v in sorted(emotion.items(), key=lambda kv: -kv[1]))
-    converged = "all converged" if all(m.get("converged") for m in data.get("movements", [])) else (
-        "some posteriors did not converge (see effort.json)")
+    converged = (
+        "all converged"
+        if all(m.get("converged") for m in data.get("movements", []))
+        else ("some posteriors did not converge (see effort.json)")
+    )
     plots = "".join(
         f'<img src="{name}" alt="{alt}" style="max-width: 48%">'
-        for name, alt in (("effort_progress.png", "progress curves with posterior bands"),
-                          ("effort_pooled.png", "pooled Effort posterior"))
+        for name, alt in (
+            ("effort_progress.png", "progress curves with posterior bands"),
+            ("effort_pooled.png", "pooled Effort posterior"),
+        )
         if name in files
     )
     return f"""<h2>Laban Effort (median and 90 % interval)</h2>
@@ -393,9 +399,12 @@ def index_html(result: CaptureResult) -> str:
         if "overlay.mp4" in result.files
         else "<p>No video: the input was a motion file.</p>"
     )
-    links = " · ".join(f'<a href="{html.escape(n)}">{html.escape(n)}</a>' for n in sorted(result.files) if n != "index.html")
-    tempo = f"{score.tempo} bpm" + (tempo_note(result.segmentation, result.kind)
-                                     if result.segmentation.tempo_estimated else "")
+    links = " · ".join(
+        f'<a href="{html.escape(n)}">{html.escape(n)}</a>' for n in sorted(result.files) if n != "index.html"
+    )
+    tempo = f"{score.tempo} bpm" + (
+        tempo_note(result.segmentation, result.kind) if result.segmentation.tempo_estimated else ""
+    )
     skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
     effort = _effort_html(result.files)

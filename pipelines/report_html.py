@@ -15,8 +15,8 @@ import math
 import re
 from pathlib import Path
 
+from capture2notation.atomic import atomic_path, write_text
 from capture2notation.errors import PipelineError
-from capture2notation.io.atomic import atomic_path, write_text
 
 __all__ = ["Report", "escape", "format_value"]
 
@@ -137,7 +137,7 @@ class Report:
 
     def html(self) -> str:
         return (
-            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
             f"<title>{escape(self.title)}</title><style>{_CSS}</style></head><body>\n"
             + "\n".join(self._parts)
             + "\n</body></html>\n"

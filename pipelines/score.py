@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from capture2notation.atomic import write_text
 from capture2notation.body import JOINTS, PARENT, joint_index
 from capture2notation.compare.align import align_dtw, align_tempo
 from capture2notation.compare.metrics import (
@@ -29,10 +30,9 @@ from capture2notation.compare.metrics import (
 )
 from capture2notation.compare.stats import sign_test, signs_from_differences
 from capture2notation.errors import PipelineError
-from capture2notation.io.atomic import write_text
 from capture2notation.notation.model import Score
 
-__all__ = ["Side", "load_side", "compare_sides", "run_score"]
+__all__ = ["Side", "compare_sides", "load_side", "run_score"]
 
 log = logging.getLogger(__name__)
 
@@ -122,12 +122,12 @@ def load_side(path, fps: float = 25.0) -> Side:
         raise PipelineError(f"{p}: no such file or capture directory")
     suffix = p.suffix.lower()
     if suffix in MOTION_SUFFIXES:
-        from capture2notation.io.motion import read_motion
+        from capture2notation.fitting.motion import read_motion
 
         m = read_motion(p)
         return Side(str(path), "motion", np.asarray(m.joints, float), float(m.fps), None, None)
     if suffix == ".npz":
-        from capture2notation.io.motion import motion_from_truth
+        from capture2notation.fitting.motion import motion_from_truth
         from capture2notation.io.truth import read_truth
 
         m = motion_from_truth(p)
@@ -195,8 +195,16 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
     from capture2notation.compare.metrics import key_frames
 
     kf = key_frames(ref_score, fps, len(rj))
-    moves = compare_movements(ref_score, rj, cj, pose_al.candidate_frame(kf), dtw_al.candidate_frame(kf),
-                              fps, fps, timing_tolerance=timing_tolerance)
+    moves = compare_movements(
+        ref_score,
+        rj,
+        cj,
+        pose_al.candidate_frame(kf),
+        dtw_al.candidate_frame(kf),
+        fps,
+        fps,
+        timing_tolerance=timing_tolerance,
+    )
     pairs = pose_al.path
     r_al, c_al = rj[pairs[:, 0]], cj[pairs[:, 1]]
     frame_mpjpe = mpjpe(_centred(r_al), _centred(c_al))
@@ -211,8 +219,10 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
     tests = [
         sign_test(signs_from_differences([m.timing_offset for m in gest], frame_step), "candidate arrives later"),
         sign_test(signs_from_differences(elev, 2.0), "candidate's limb is higher"),
-        sign_test(signs_from_differences([m.ref_angle_error - m.angle_error for m in gest], 2.0),
-                  "candidate is nearer the notated direction"),
+        sign_test(
+            signs_from_differences([m.ref_angle_error - m.angle_error for m in gest], 2.0),
+            "candidate is nearer the notated direction",
+        ),
     ]
     eff = effort_differences(cand.effort, ref.effort) if cand.effort and ref.effort else {}
     return {
@@ -260,8 +270,10 @@ def summary_dict(cand: Side, ref: Side, res: dict) -> dict:
         "angle_error_deg": {"mean": float(np.nanmean([m.pose_error for m in gest])) if gest else None},
         "mpjpe_mm": float(np.nanmean(res["mpjpe_mm"])),
         "pa_mpjpe_mm": float(np.nanmean(res["pa_mpjpe_mm"])),
-        "timing_offset_s": {"mean": float(np.mean([m.timing_offset for m in gest])) if gest else None,
-                            "mean_abs": float(np.mean([abs(m.timing_offset) for m in gest])) if gest else None},
+        "timing_offset_s": {
+            "mean": float(np.mean([m.timing_offset for m in gest])) if gest else None,
+            "mean_abs": float(np.mean([abs(m.timing_offset) for m in gest])) if gest else None,
+        },
         "effort_differences": res["effort"],
         "verdicts": verdicts,
         "movements": [m.as_dict() for m in moves],
@@ -289,7 +301,6 @@ def _json_default(o):
     if isinstance(o, np.bool_):
         return bool(o)
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
-
 
 
 # --- report ----------------------------------------------------------------------
@@ -324,8 +335,9 @@ def _key_pose_figure(res: dict, max_poses: int = 8):
         _stick(ax, res["_ref"][m.ref_frame], -0.5, "black")
         _stick(ax, res["_cand"][m.cand_frame], 0.5, "#2a6fc9" if m.agree else "#c0392b")
         ax.set_aspect("equal")
-        ax.set_title(f"{m.part} {m.direction} {m.level}\n→ {m.cand_direction or '?'} {m.cand_level} ({m.verdict})",
-                     fontsize=8)
+        ax.set_title(
+            f"{m.part} {m.direction} {m.level}\n→ {m.cand_direction or '?'} {m.cand_level} ({m.verdict})", fontsize=8
+        )
     fig.suptitle("Key poses: reference (black, left) and candidate (blue = same symbol, red = different)", fontsize=9)
     fig.tight_layout(rect=(0, 0, 1, 0.93))
     return fig
@@ -374,25 +386,43 @@ def write_score_report(cand: Side, ref: Side, res: dict, summ: dict, outdir) -> 
         fig, ax = plt.subplots(figsize=(5, 3))
         names = list(res["effort"])
         d = [res["effort"][n] for n in names]
-        ax.errorbar(range(len(names)), [x["difference"] for x in d],
-                    yerr=[[x["difference"] - x["lo"] for x in d], [x["hi"] - x["difference"] for x in d]],
-                    fmt="o", capsize=4)
+        ax.errorbar(
+            range(len(names)),
+            [x["difference"] for x in d],
+            yerr=[[x["difference"] - x["lo"] for x in d], [x["hi"] - x["difference"] for x in d]],
+            fmt="o",
+            capsize=4,
+        )
         ax.axhline(0, color="grey", lw=0.8)
         ax.set_xticks(range(len(names)), names)
         ax.set_ylabel("candidate − reference")
         rep.figure(fig, "effort", "Effort differences with their intervals (0 inside = consistent).")
     rep.heading("Movements")
-    cols = ["index", "part", "direction", "level", "cand_direction", "cand_level", "angle_error", "pose_error",
-            "timing_offset", "verdict"]
+    cols = [
+        "index",
+        "part",
+        "direction",
+        "level",
+        "cand_direction",
+        "cand_level",
+        "angle_error",
+        "pose_error",
+        "timing_offset",
+        "verdict",
+    ]
     rep.table([m.as_dict() for m in res["movements"]], cols)
     rep.heading("Symbol agreement per part")
     rep.table([{"part": k, **v} for k, v in summ["agreement_by_part"].items()], ["part", "n", "agree", "fraction"])
     rep.heading("Sign tests over movements (as Wolofsky 1974, Table III)")
-    rep.table([t.as_dict() for t in res["sign_tests"]],
-              ["question", "positive", "negative", "total", "fewer", "p", "significant"],
-              caption="One-tailed binomial probability of the fewer signs; ties dropped; 5 % level.")
+    rep.table(
+        [t.as_dict() for t in res["sign_tests"]],
+        ["question", "positive", "negative", "total", "fewer", "p", "significant"],
+        caption="One-tailed binomial probability of the fewer signs; ties dropped; 5 % level.",
+    )
     if res["effort"]:
         rep.heading("Effort differences")
-        rep.table([{"parameter": k, **v} for k, v in res["effort"].items()],
-                  ["parameter", "difference", "lo", "hi", "consistent"])
+        rep.table(
+            [{"parameter": k, **v} for k, v in res["effort"].items()],
+            ["parameter", "difference", "lo", "hi", "consistent"],
+        )
     return rep.write("report.html")

@@ -21,10 +21,10 @@ from __future__ import annotations
 import numpy as np
 
 from capture2notation.body import Body, joint_index
-from capture2notation.effort.model import progress
+from capture2notation.notation.effort import progress
 from capture2notation.notation.model import Effort
 
-__all__ = ["PART_JOINTS", "CLIP_TOL", "keep_paths_within", "nearest_at_lock", "continuous_at_lock"]
+__all__ = ["CLIP_TOL", "PART_JOINTS", "continuous_at_lock", "keep_paths_within", "nearest_at_lock"]
 
 #: Joints whose extremes bound each part's movement.
 PART_JOINTS = {

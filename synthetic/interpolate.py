@@ -4,29 +4,29 @@ Every function maps normalised time ``tau`` in [0, 1] to normalised progress
 ``s`` in [0, 1] with s(0) = 0, s(1) = 1 and s non-decreasing.  Cachola's
 LIG ANIMATE offers *linear*, *accelerate*, *decelerate* and *accelerate-
 decelerate* between key frames; Neagle's virtual dancer uses the Laban
-Effort logistic, which is :func:`capture2notation.effort.model.progress`
+Effort logistic, which is :func:`capture2notation.notation.effort.progress`
 (re-exported here, not re-implemented).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import MappingProxyType
-from typing import Callable
 
 import numpy as np
 
-from capture2notation.effort.model import progress
 from capture2notation.errors import SyntheticError
+from capture2notation.notation.effort import progress
 from capture2notation.notation.model import Effort
 
 __all__ = [
     "INTERPOLATIONS",
-    "linear",
     "accelerate",
-    "decelerate",
     "accelerate_decelerate",
-    "effort_easing",
+    "decelerate",
     "easing",
+    "effort_easing",
+    "linear",
     "progress",
 ]
 
@@ -118,6 +118,5 @@ def easing(kind) -> Callable[[np.ndarray], np.ndarray]:
     if isinstance(kind, str) and kind in INTERPOLATIONS:
         return INTERPOLATIONS[kind]
     raise SyntheticError(
-        f"unknown interpolation {kind!r}; expected one of {', '.join(INTERPOLATIONS)}, "
-        "an Effort or a function tau -> s"
+        f"unknown interpolation {kind!r}; expected one of {', '.join(INTERPOLATIONS)}, an Effort or a function tau -> s"
     )

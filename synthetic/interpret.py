@@ -57,14 +57,13 @@ from .rotations import rot_between
 from .supports import PLIE_BEND_DEG, RELEVE_DEG, STEP_LENGTH, Support, leg_tracks
 from .trunk import chest_reach, direction_track, trunk_angles
 
-__all__ = ["interpret", "unreachable", "UnreachableWarning", "beat_frame", "STEP_LENGTH", "PLIE_BEND_DEG", "RELEVE_DEG"]
+__all__ = ["PLIE_BEND_DEG", "RELEVE_DEG", "STEP_LENGTH", "UnreachableWarning", "beat_frame", "interpret", "unreachable"]
 
 
 def beat_frame(beat, tempo, fps: float) -> int:
     """Frame index of a beat: round half up of ``beat × 60 / tempo × fps``."""
     x = float(Fraction(beat) * 60 / Fraction(tempo)) * fps
     return int(np.floor(x + 0.5 + 1e-9))
-
 
 
 def interpret(score: Score, fps: float = 25.0, body: Body | None = None, effort: Effort | None = None) -> Motion:
@@ -151,5 +150,3 @@ def interpret(score: Score, fps: float = 25.0, body: Body | None = None, effort:
     for u in reach_report(motion, angles):
         warnings.warn(u.message(), UnreachableWarning, stacklevel=2)
     return motion
-
-

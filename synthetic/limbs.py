@@ -24,16 +24,16 @@ from __future__ import annotations
 import numpy as np
 
 from capture2notation.body import Body, joint_index
-from capture2notation.effort.model import progress, space_radius
 from capture2notation.errors import SyntheticError
 from capture2notation.notation.directions import canonical_vector
+from capture2notation.notation.effort import progress, space_radius
 from capture2notation.notation.model import Effort
 
-from .rotations import Z as _Z
 from .motion import euler_near
+from .rotations import Z as _Z
 from .rotations import axis_angle, great_circle_frames, rot_between, rot_x, slerp_frames, unit
 
-__all__ = ["LIMBS", "Limb", "apply_move", "limb_target", "group_moves"]
+__all__ = ["LIMBS", "Limb", "apply_move", "group_moves", "limb_target"]
 
 # Limbs: name -> (whole part, upper part, lower part, bound, middle, free joint, sign).
 # sign +1: the middle joint flexes forward (elbow rx > 0); −1: backward (knee rx < 0).
@@ -252,8 +252,11 @@ def group_moves(limb: Limb, symbols, frame, T):
     moves: list = []
     for s in syms:
         f0, f1 = frame(s.start), frame(s.end)
-        if moves and (s.start, s.end) == moves[-1][3] and s.part != limb.whole and all(
-            p.part != limb.whole and p.part != s.part for p in moves[-1][2]
+        if (
+            moves
+            and (s.start, s.end) == moves[-1][3]
+            and s.part != limb.whole
+            and all(p.part != limb.whole and p.part != s.part for p in moves[-1][2])
         ):
             moves[-1][2].append(s)
             continue

@@ -23,9 +23,9 @@ interpolation), Cachola's explicit ``STARTMOTION … ENDMOTION`` definition.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import reduce
-from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -35,7 +35,7 @@ from capture2notation.errors import SyntheticError
 
 from .interpolate import easing
 
-__all__ = ["Motion", "Keyframe", "keyframed", "synchronize", "euler_near"]
+__all__ = ["Keyframe", "Motion", "euler_near", "keyframed", "synchronize"]
 
 _J = len(JOINTS)
 
@@ -114,7 +114,7 @@ class Motion:
         """World joint positions, (T, J, 3) metres (NaN below absent joints)."""
         return forward_kinematics(self.angles, self.root, self.body)
 
-    def allclose(self, other: "Motion", atol: float = 1e-9) -> bool:
+    def allclose(self, other: Motion, atol: float = 1e-9) -> bool:
         """Same fps, body, frame count, and equal angles/root (NaN equal NaN)."""
         return (
             isinstance(other, Motion)
@@ -126,7 +126,7 @@ class Motion:
         )
 
     # -- algebra -------------------------------------------------------------
-    def __add__(self, other: "Motion") -> "Motion":
+    def __add__(self, other: Motion) -> Motion:
         if not isinstance(other, Motion):
             return NotImplemented
         if other.fps != self.fps or other.body != self.body:
@@ -147,7 +147,7 @@ class Motion:
             events,
         )
 
-    def __mul__(self, k: int) -> "Motion":
+    def __mul__(self, k: int) -> Motion:
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
             return NotImplemented
         if k < 1:
@@ -156,7 +156,7 @@ class Motion:
 
     __rmul__ = __mul__
 
-    def strip(self, joints: Iterable[str]) -> "Motion":
+    def strip(self, joints: Iterable[str]) -> Motion:
         """Partial motion animating only `joints` (Cachola's STRIP).
 
         Parameters
@@ -172,7 +172,7 @@ class Motion:
         root = self.root if keep[0] else np.full_like(self.root, np.nan)
         return Motion(self.fps, angles, root, self.body, ())
 
-    def scale_frames(self, k: float) -> "Motion":
+    def scale_frames(self, k: float) -> Motion:
         """Temporal stretch by `k` (Cachola's SCALE FRAMES).
 
         The motion keeps its first and last poses; ``(T − 1)·|k|`` intervals
@@ -200,7 +200,7 @@ class Motion:
             events = tuple((s, int(round(a * f)), int(round(b * f))) for s, a, b in self.events)
         return Motion(self.fps, angles, root, self.body, events)
 
-    def scale_extremes(self, k: float) -> "Motion":
+    def scale_extremes(self, k: float) -> Motion:
         """Scale every joint angle by `k` about the neutral pose (SCALE EXTREMES).
 
         The result is clipped to the body's extremes like any motion; the
@@ -212,7 +212,7 @@ class Motion:
         return Motion(self.fps, self.angles * k, self.root, self.body, ())
 
     @classmethod
-    def rest(cls, n_frames: int = 1, fps: float = 25.0, body: Body | None = None) -> "Motion":
+    def rest(cls, n_frames: int = 1, fps: float = 25.0, body: Body | None = None) -> Motion:
         """The rest pose held for `n_frames` frames."""
         body = body or Body()
         if n_frames < 1:
@@ -242,7 +242,9 @@ def synchronize(*motions: Motion) -> Motion:
     events: list = []
     for i, m in enumerate(motions):
         if m.fps != first.fps or m.body != first.body:
-            raise SyntheticError(f"synchronize: motion {i} has fps {m.fps} / body {m.body}, expected {first.fps} / {first.body}")
+            raise SyntheticError(
+                f"synchronize: motion {i} has fps {m.fps} / body {m.body}, expected {first.fps} / {first.body}"
+            )
         clash = m.present & (owner >= 0)
         if np.any(clash):
             j = int(np.flatnonzero(clash)[0])
@@ -322,7 +324,9 @@ def keyframed(
             f = int(k.frame)
             a = np.asarray(k.angles, dtype=float)
             if a.shape != (3,) or not np.all(np.isfinite(a)):
-                raise SyntheticError(f"keyframe {i} of joint {name!r}: angles must be 3 finite numbers, got {k.angles!r}")
+                raise SyntheticError(
+                    f"keyframe {i} of joint {name!r}: angles must be 3 finite numbers, got {k.angles!r}"
+                )
             if f < prev_f or (i > 0 and f == prev_f) or f >= T:
                 raise SyntheticError(
                     f"keyframe {i} of joint {name!r} at frame {f}: frames must increase and lie in [0, {T - 1}]"

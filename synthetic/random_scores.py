@@ -44,7 +44,7 @@ import numpy as np
 from capture2notation.errors import SyntheticError
 from capture2notation.notation.model import Effort, Score, Symbol
 
-__all__ = ["random_score", "DEFAULT_PARTS", "ARM_TARGETS", "HEAD_TARGETS", "CHEST_TARGETS"]
+__all__ = ["ARM_TARGETS", "CHEST_TARGETS", "DEFAULT_PARTS", "HEAD_TARGETS", "random_score"]
 
 #: Parts drawn by default; ``"legs"`` stands for supports plus leg gestures.
 DEFAULT_PARTS: tuple[str, ...] = ("right_arm", "left_arm", "head", "chest", "legs")
@@ -108,8 +108,11 @@ def _chest_targets() -> tuple:
     from .trunk import chest_reach
 
     reach = chest_reach(Body())
-    return tuple(t for t in HEAD_TARGETS
-                 if np.allclose(reach(canonical_vector(t[0], t[1])[None])[0], canonical_vector(t[0], t[1]), atol=1e-9))
+    return tuple(
+        t
+        for t in HEAD_TARGETS
+        if np.allclose(reach(canonical_vector(t[0], t[1])[None])[0], canonical_vector(t[0], t[1]), atol=1e-9)
+    )
 
 
 #: Chest: the head's targets within the trunk's extremes.

@@ -31,12 +31,12 @@ from capture2notation.body import JOINTS, body_frame, forward_kinematics, joint_
 from capture2notation.notation.directions import bend_angle, bend_degree, classify_indices
 from capture2notation.notation.model import DIRECTIONS, LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Symbol
 
-_PLACE = list(DIRECTIONS).index("place")
-
 from .extremes import CLIP_TOL, PART_JOINTS
 from .motion import Motion
 
-__all__ = ["UnreachableWarning", "Unreached", "unreachable", "reach_report"]
+_PLACE = list(DIRECTIONS).index("place")
+
+__all__ = ["UnreachableWarning", "Unreached", "reach_report", "unreachable"]
 
 _FEET = {"support": ("right", "left"), "right_support": ("right",), "left_support": ("left",)}
 #: Parts whose holds are checked (legs are driven by the supports between gestures).
@@ -85,10 +85,12 @@ class Unreached:
     def message(self) -> str:
         """One line naming the symbol (start, part, direction, level) and the limit."""
         s = self.symbol
-        what_sym = (f"{s.part} {s.direction} {s.level} bend={s.bend} at beat {s.start}" if s is not None
-                    else f"{self.part} {_START[self.part]} (the start pose)")
-        what = {"end": "is out of reach", "path": "is out of reach on the way",
-                "hold": "cannot be held"}[self.kind]
+        what_sym = (
+            f"{s.part} {s.direction} {s.level} bend={s.bend} at beat {s.start}"
+            if s is not None
+            else f"{self.part} {_START[self.part]} (the start pose)"
+        )
+        what = {"end": "is out of reach", "path": "is out of reach on the way", "hold": "cannot be held"}[self.kind]
         got = f": the dancer gets to {' '.join(str(x) for x in self.got)}" if self.got else ""
         why = f"; limit: {self.limit}" if self.limit else "; no joint extreme hit (floor or another part's pose)"
         return f"{what_sym} {what} (frame {self.frame}){got}{why}"
@@ -155,8 +157,10 @@ def _limit_hit(raw, clipped, limits, joints, frames) -> str:
             best = abs(over[k])
             side = ">=" if over[k] < 0 else "<="
             bound = limits[j, k[1], 0 if over[k] < 0 else 1]
-            text = (f"{JOINTS[j]} {_AXES[k[1]]} {side} {np.degrees(bound):.0f}°: "
-                    f"asked {np.degrees(raw[frames[k[0]], j, k[1]]):.1f}°")
+            text = (
+                f"{JOINTS[j]} {_AXES[k[1]]} {side} {np.degrees(bound):.0f}°: "
+                f"asked {np.degrees(raw[frames[k[0]], j, k[1]]):.1f}°"
+            )
     if not text:
         # Nothing clipped: a joint the interpreter itself held at an extreme
         # (the trunk solves its tilt within them).
@@ -211,22 +215,35 @@ def reach_report(motion: Motion, raw_angles: np.ndarray | None = None) -> list:
                     # A foot that stays on the floor must read as supporting
                     # throughout: a heel dropped or raised too fast does not.
                     f = f0 + int(np.argmin(sup[f0 : f1 + 1]))
-                    out.append(Unreached(sym, sym.part, "path", f, ("none", "", 0),
-                                         f"the {foot} foot moves faster than {_SUPPORT_SPEED} m/s "
-                                         "(DESIGN.md's support threshold); give the level change more time"))
+                    out.append(
+                        Unreached(
+                            sym,
+                            sym.part,
+                            "path",
+                            f,
+                            ("none", "", 0),
+                            f"the {foot} foot moves faster than {_SUPPORT_SPEED} m/s "
+                            "(DESIGN.md's support threshold); give the level change more time",
+                        )
+                    )
                     break
                 if not sup[f1] or LEVELS[lev[f1]] != sym.level:
                     got = ("place", LEVELS[lev[f1]], 0) if sup[f1] else ("none", "", 0)
                     leg = PART_JOINTS[f"{foot}_support"]
-                    out.append(Unreached(sym, sym.part, "end", f1, got, _limit_hit(raw_angles, clipped, limits, leg, [f1])))
+                    out.append(
+                        Unreached(sym, sym.part, "end", f1, got, _limit_hit(raw_angles, clipped, limits, leg, [f1]))
+                    )
                     break
             continue
         if sym.part not in readings:
             readings[sym.part] = _readings(J, sym.part)
         d, lv, bend = (r[f1] for r in readings[sym.part])
         if (d, lv, bend) != _code(sym):
-            out.append(Unreached(sym, sym.part, "end", f1, _name(d, lv, bend),
-                                 _limit_hit(raw_angles, clipped, limits, joints, [f1])))
+            out.append(
+                Unreached(
+                    sym, sym.part, "end", f1, _name(d, lv, bend), _limit_hit(raw_angles, clipped, limits, joints, [f1])
+                )
+            )
     out += _holds(motion, J, raw_angles, readings)
     return out
 
@@ -242,7 +259,7 @@ def _holds(motion: Motion, J, raw_angles, readings) -> list:
             continue  # segment symbols: the whole arm's reading is not notated
         moving = np.zeros(T, bool)
         held = np.full(T, -1)
-        for i, (s, f0, f1) in enumerate(own):
+        for i, (_s, f0, f1) in enumerate(own):
             moving[f0 + 1 : f1 + 1] = True  # the end frame is checked as an "end"
             held[f1:] = i
         if part not in readings:
@@ -253,8 +270,11 @@ def _holds(motion: Motion, J, raw_angles, readings) -> list:
             sym = None if i < 0 else syms[i]
             frames = np.flatnonzero((held == i) & ~moving)
             code = _code(sym) if sym is not None else (_PLACE, LEVELS.index(_START[part].split()[1]), 0)
-            bad = frames[(d[frames] != code[0]) | (lv[frames] != code[1])
-                         | ((bend[frames] != code[2]) if part in PART_MIDDLE_JOINT else False)]
+            bad = frames[
+                (d[frames] != code[0])
+                | (lv[frames] != code[1])
+                | ((bend[frames] != code[2]) if part in PART_MIDDLE_JOINT else False)
+            ]
             if bad.size:
                 f = int(bad[0])
                 hit = _limit_hit(raw_angles, motion.angles, motion.body.limits, PART_JOINTS[part], [f])

@@ -12,14 +12,14 @@ from scipy.spatial.transform import Rotation
 
 __all__ = [
     "Z",
-    "unit",
-    "rot_x",
-    "cross",
     "axis_angle",
-    "rot_between",
-    "slerp_frames",
+    "cross",
     "great_circle_frames",
+    "rot_between",
+    "rot_x",
     "slerp_dirs",
+    "slerp_frames",
+    "unit",
 ]
 
 #: World / body-frame up.
@@ -48,8 +48,11 @@ def cross(a, b):
     """Cross product of (..., 3) arrays (broadcast; faster than ``np.cross`` on small stacks)."""
     a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
     return np.stack(
-        [a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-         a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]],
+        [
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+        ],
         axis=-1,
     )
 
@@ -130,8 +133,10 @@ def great_circle_frames(Pa, Pb, s, prefer):
     tw = (G @ Pa).T @ Pb  # a turn about the limb's own axis
     psi = np.arctan2(tw[1, 0], tw[0, 0])
     s = np.asarray(s, float)
-    return axis_angle(np.broadcast_to(n, s.shape + (3,)), s * theta) @ Pa @ axis_angle(
-        np.broadcast_to(_Z, s.shape + (3,)), s * psi
+    return (
+        axis_angle(np.broadcast_to(n, s.shape + (3,)), s * theta)
+        @ Pa
+        @ axis_angle(np.broadcast_to(_Z, s.shape + (3,)), s * psi)
     )
 
 

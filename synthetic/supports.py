@@ -20,14 +20,15 @@ thigh frames, knee bends and ankle angles.
 
 from __future__ import annotations
 
+import itertools
 import logging
 
 import numpy as np
 
 from capture2notation.body import Body, euler_to_matrix, joint_index
-from capture2notation.effort.model import progress
 from capture2notation.errors import SyntheticError
 from capture2notation.notation.directions import canonical_vector
+from capture2notation.notation.effort import progress
 from capture2notation.notation.model import Effort, Score
 
 from .extremes import keep_paths_within
@@ -35,7 +36,7 @@ from .limbs import Limb, apply_move, group_moves
 from .motion import euler_near
 from .rotations import rot_x, slerp_frames, unit
 
-__all__ = ["STEP_LENGTH", "PLIE_BEND_DEG", "RELEVE_DEG", "STEP_LIFT", "SUPPORT_FEET", "Support", "leg_tracks"]
+__all__ = ["PLIE_BEND_DEG", "RELEVE_DEG", "STEP_LENGTH", "STEP_LIFT", "SUPPORT_FEET", "Support", "leg_tracks"]
 
 log = logging.getLogger(__name__)
 
@@ -69,12 +70,13 @@ _SUPPORT_SPEED = 0.2
 
 SUPPORT_FEET = {"support": ("right", "left"), "right_support": ("right",), "left_support": ("left",)}
 
+
 def _foot_events(score: Score, foot: str):
     """Support symbols naming `foot` and gesture symbols of its leg, in time order."""
     leg = {f"{foot}_leg", f"{foot}_thigh", f"{foot}_shin"}
     sup = [s for s in score.symbols if s.part in SUPPORT_FEET and foot in SUPPORT_FEET[s.part]]
     ges = [s for s in score.symbols if s.part in leg]
-    for a, b in zip(sup, sup[1:]):
+    for a, b in itertools.pairwise(sup):
         if b.start < a.end:
             raise SyntheticError(
                 f"{b.part} at beat {b.start} overlaps {a.part} at beat {a.start}-{a.end} on the {foot} foot"
@@ -181,7 +183,7 @@ class Support:
     def _plan(self, score: Score):
         frame, T, body = self.frame, self.T, self.body
         xy = {f: body.rest[joint_index(f"{f}_ankle")][:2].copy() for f in ("right", "left")}
-        level = {f: "middle" for f in ("right", "left")}
+        level = dict.fromkeys(("right", "left"), "middle")
         sups = sorted((s for s in score.symbols if s.is_support), key=lambda s: (s.end, s.start))
         for s in sups:
             if s.part == "support" and s.direction != "place":
@@ -343,7 +345,9 @@ class Support:
             ankle = np.clip(euler_near(shin.transpose(0, 2, 1) @ foot_R, 0.0, lim), lim[:, 0], lim[:, 1])
             # Past the ankle's extremes (a plié with the feet far apart) the
             # foot cannot stay flat: the heel lifts so the toe stays on the floor.
-            deficit = (self.toe0 if toe_min is None else toe_min) - (ankle_pos + (shin @ euler_to_matrix(ankle)) @ toe)[:, 2]
+            deficit = (self.toe0 if toe_min is None else toe_min) - (ankle_pos + (shin @ euler_to_matrix(ankle)) @ toe)[
+                :, 2
+            ]
             if not np.any(deficit > 1e-6):
                 break
             ankle_pos[:, 2] += np.maximum(deficit, 0.0)
@@ -405,8 +409,9 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
             ankle[low, 0] = np.maximum(ankle[low, 0], flat[:, 0])
             flex = low & steady
             if np.any(flex):
-                ankle[flex] = _flex_clear(sup.body, foot, limb, Qf[flex], bf[flex], ankle[flex], hip[flex],
-                                          clear[flex], lim)
+                ankle[flex] = _flex_clear(
+                    sup.body, foot, limb, Qf[flex], bf[flex], ankle[flex], hip[flex], clear[flex], lim
+                )
                 deficit = clear - _toe(sup.body, foot, limb, Qf, bf, ankle, hip)[:, 2]
                 low = free & (deficit > 1e-6)
                 if not np.any(low):

@@ -22,13 +22,13 @@ from __future__ import annotations
 import numpy as np
 
 from capture2notation.body import Body, euler_to_matrix, joint_index, matrix_to_euler
-from capture2notation.effort.model import progress
 from capture2notation.notation.directions import canonical_vector
+from capture2notation.notation.effort import progress
 
 from .rotations import Z as _Z
 from .rotations import axis_angle, cross, slerp_dirs, unit
 
-__all__ = ["direction_track", "trunk_angles", "chest_reach"]
+__all__ = ["chest_reach", "direction_track", "trunk_angles"]
 
 
 def direction_track(symbols, part, frame, T, eff, reach=None):

@@ -29,7 +29,9 @@ def fixture_path():
     def get(rel: str) -> Path:
         p = fixtures_dir() / rel
         if not p.exists():
-            pytest.skip(f"fixture {rel} not found under {fixtures_dir()} (set C2N_FIXTURES or place ../shared beside the repo)")
+            pytest.skip(
+                f"fixture {rel} not found under {fixtures_dir()} (set C2N_FIXTURES or place ../shared beside the repo)"
+            )
         return p
 
     return get

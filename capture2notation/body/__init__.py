@@ -17,9 +17,9 @@ from .skeleton import (
 __all__ = [
     "BLAZEPOSE_LANDMARKS",
     "BLAZEPOSE_TO_JOINT",
+    "JOINTS",
     "JOINT_INDEX",
     "JOINT_TO_BLAZEPOSE",
-    "JOINTS",
     "PARENT",
     "Body",
     "body_frame",

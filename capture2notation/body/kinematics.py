@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import BodyModelError
 from .skeleton import JOINTS, Body
 
-__all__ = ["euler_to_matrix", "matrix_to_euler", "forward_kinematics", "global_rotations"]
+__all__ = ["euler_to_matrix", "forward_kinematics", "global_rotations", "matrix_to_euler"]
 
 
 def euler_to_matrix(angles: np.ndarray) -> np.ndarray:
@@ -138,9 +138,7 @@ def forward_kinematics(
         root_position = np.broadcast_to(body.rest[0], (T, 3))
     root_position = np.asarray(root_position, dtype=float)
     if root_position.shape != (T, 3):
-        raise BodyModelError(
-            f"root_position must have shape ({T}, 3) to match angles, got {root_position.shape}"
-        )
+        raise BodyModelError(f"root_position must have shape ({T}, 3) to match angles, got {root_position.shape}")
     glob = _global_soa(angles, body)  # (J, 3, 3, T)
     pos = np.empty((len(JOINTS), 3, T))
     pos[0] = root_position.T
@@ -154,7 +152,5 @@ def forward_kinematics(
 def _check(angles: np.ndarray) -> np.ndarray:
     angles = np.asarray(angles, dtype=float)
     if angles.ndim != 3 or angles.shape[1:] != (len(JOINTS), 3):
-        raise BodyModelError(
-            f"angles must have shape (T, {len(JOINTS)}, 3), got {angles.shape}"
-        )
+        raise BodyModelError(f"angles must have shape (T, {len(JOINTS)}, 3), got {angles.shape}")
     return angles

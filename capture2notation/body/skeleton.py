@@ -30,13 +30,13 @@ import numpy as np
 from ..errors import BodyModelError
 
 __all__ = [
-    "JOINTS",
-    "PARENT",
-    "JOINT_INDEX",
     "BLAZEPOSE_LANDMARKS",
     "BLAZEPOSE_TO_JOINT",
+    "JOINTS",
+    "JOINT_INDEX",
     "JOINT_TO_BLAZEPOSE",
     "LIMITS_DEG",
+    "PARENT",
     "Body",
     "joint_index",
 ]
@@ -101,9 +101,7 @@ def joint_index(name: str) -> int:
     try:
         return JOINT_INDEX[name]
     except KeyError:
-        raise BodyModelError(
-            f"unknown joint {name!r}; expected one of {', '.join(JOINTS)}"
-        ) from None
+        raise BodyModelError(f"unknown joint {name!r}; expected one of {', '.join(JOINTS)}") from None
 
 
 #: The 33 BlazePose landmarks, in model output order.
@@ -164,9 +162,7 @@ BLAZEPOSE_TO_JOINT: MappingProxyType = MappingProxyType(
         32: "right_toe",
     }
 )
-JOINT_TO_BLAZEPOSE: MappingProxyType = MappingProxyType(
-    {j: i for i, j in BLAZEPOSE_TO_JOINT.items()}
-)
+JOINT_TO_BLAZEPOSE: MappingProxyType = MappingProxyType({j: i for i, j in BLAZEPOSE_TO_JOINT.items()})
 
 #: Joint limits ("extremes", Cachola 1986 §3) in degrees, (min, max) per axis
 #: (rx, ry, rz) for the *right* side and the trunk; the left side mirrors ry
@@ -283,13 +279,9 @@ class Body:
 
     def __post_init__(self):
         if not (np.isfinite(self.height) and 0.3 <= self.height <= 3.0):
-            raise BodyModelError(
-                f"body height {self.height!r} m is outside the plausible range 0.3-3.0 m"
-            )
+            raise BodyModelError(f"body height {self.height!r} m is outside the plausible range 0.3-3.0 m")
         rest = _rest_positions(float(self.height))
-        parents = np.array(
-            [-1 if PARENT[n] is None else JOINT_INDEX[PARENT[n]] for n in JOINTS]
-        )
+        parents = np.array([-1 if PARENT[n] is None else JOINT_INDEX[PARENT[n]] for n in JOINTS])
         offsets = rest - np.where(parents[:, None] >= 0, rest[parents], 0.0)
         offsets[0] = 0.0
         limits = _limits_array() * self.limit_scale
@@ -325,7 +317,5 @@ class Body:
         """
         angles = np.asarray(angles, dtype=float)
         if angles.shape[-2:] != (len(JOINTS), 3):
-            raise BodyModelError(
-                f"angles must have shape (..., {len(JOINTS)}, 3), got {angles.shape}"
-            )
+            raise BodyModelError(f"angles must have shape (..., {len(JOINTS)}, 3), got {angles.shape}")
         return np.clip(angles, self.limits[..., 0], self.limits[..., 1])

@@ -15,7 +15,7 @@ from ..body import body_frame, joint_index
 from ..errors import CompareError
 from ..notation.model import PART_SEGMENTS
 
-__all__ = ["Alignment", "limb_features", "dtw", "align_dtw", "align_tempo"]
+__all__ = ["Alignment", "align_dtw", "align_tempo", "dtw", "limb_features"]
 
 #: Limbs whose directions drive the alignment (whole limbs, head, chest):
 #: the segments that Labanotation's main columns notate.
@@ -173,7 +173,9 @@ def align_dtw(ref_joints: np.ndarray, cand_joints: np.ndarray, band: int | None 
     return Alignment(path=path, cost=total / len(path), method="dtw")
 
 
-def align_tempo(n_ref: int, n_cand: int, ref_tempo: float, cand_tempo: float, fps_ref: float, fps_cand: float) -> Alignment:
+def align_tempo(
+    n_ref: int, n_cand: int, ref_tempo: float, cand_tempo: float, fps_ref: float, fps_cand: float
+) -> Alignment:
     """Align two performances of scores by their tempi: same beat ↔ same pose.
 
     Reference frame i at time ``i / fps_ref`` is beat ``t·tempo_ref/60``;

@@ -25,13 +25,13 @@ import numpy as np
 from ..errors import CompareError
 
 __all__ = [
-    "THESIS",
     "FEATURES",
+    "THESIS",
+    "SameDifferentObserver",
     "Trial",
     "experiment1_trials",
     "experiment2_trials",
     "feature_vector",
-    "SameDifferentObserver",
     "run_trials",
     "summarise",
 ]
@@ -136,6 +136,7 @@ def feature_vector(effort: dict) -> np.ndarray:
     (4,) ndarray
         In the order of :data:`FEATURES`.
     """
+
     def get(k):
         v = effort.get(k, np.nan)
         try:
@@ -190,7 +191,7 @@ class SameDifferentObserver:
         return np.where(np.isnan(dist), False, dist <= self.threshold)
 
     @classmethod
-    def calibrate(cls, features: np.ndarray, emotions) -> "SameDifferentObserver":
+    def calibrate(cls, features: np.ndarray, emotions) -> SameDifferentObserver:
         """Fit scale and threshold on a training set of performances.
 
         Every pair of distinct training performances is a training trial;
@@ -273,11 +274,20 @@ def run_trials(trials, pool: dict, observer: SameDifferentObserver, rng: np.rand
             ia, ib = rng.integers(len(pa)), rng.integers(len(pb))
         fa, fb = pa[ia], pb[ib]
         said = bool(observer.judge(fa, fb))
-        out.append({
-            "emotion_a": t.emotion_a, "emotion_b": t.emotion_b, "pair": t.pair, "same": t.same,
-            "complexity": t.complexity, "frame_rate": float(t.frame_rate), "repeat": t.repeat,
-            "said_same": said, "correct": said == t.same, "distance": float(observer.distance(fa, fb)),
-        })
+        out.append(
+            {
+                "emotion_a": t.emotion_a,
+                "emotion_b": t.emotion_b,
+                "pair": t.pair,
+                "same": t.same,
+                "complexity": t.complexity,
+                "frame_rate": float(t.frame_rate),
+                "repeat": t.repeat,
+                "said_same": said,
+                "correct": said == t.same,
+                "distance": float(observer.distance(fa, fb)),
+            }
+        )
     return out
 
 

@@ -18,17 +18,17 @@ from ..notation.directions import bend_angle, bend_degree, canonical_vector, cla
 from ..notation.model import DIRECTIONS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score
 
 __all__ = [
+    "MovementResult",
+    "agreement_by_part",
+    "angle_between",
+    "compare_movements",
+    "effort_differences",
+    "key_frames",
     "mpjpe",
-    "procrustes_align",
+    "notation_agreement",
     "pa_mpjpe",
     "part_vectors",
-    "angle_between",
-    "key_frames",
-    "MovementResult",
-    "compare_movements",
-    "agreement_by_part",
-    "effort_differences",
-    "notation_agreement",
+    "procrustes_align",
 ]
 
 _DIRS = tuple(DIRECTIONS)
@@ -139,7 +139,9 @@ def part_vectors(joints: np.ndarray, parts) -> np.ndarray:
         a = np.array([joint_index(PART_SEGMENTS[p][0]) for p in parts], dtype=int)
         b = np.array([joint_index(PART_SEGMENTS[p][1]) for p in parts], dtype=int)
     except KeyError as exc:
-        raise CompareError(f"part {exc.args[0]!r} has no limb segment; expected one of {' '.join(PART_SEGMENTS)}") from None
+        raise CompareError(
+            f"part {exc.args[0]!r} has no limb segment; expected one of {' '.join(PART_SEGMENTS)}"
+        ) from None
     v = joints[:, b] - joints[:, a]
     nrm = np.linalg.norm(v, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -288,9 +290,26 @@ def compare_movements(
     for i, sym in enumerate(ref_score.symbols):
         offset = float(arrival_frames[i] / fps_cand - kf[i] / fps_ref)
         if sym.part not in PART_SEGMENTS:
-            out.append(MovementResult(i, sym.part, sym.direction, sym.level, sym.bend, int(kf[i]),
-                                      int(pose_frames[i]), "", "", -1, False, np.nan, np.nan, np.nan,
-                                      offset, "n/a"))
+            out.append(
+                MovementResult(
+                    i,
+                    sym.part,
+                    sym.direction,
+                    sym.level,
+                    sym.bend,
+                    int(kf[i]),
+                    int(pose_frames[i]),
+                    "",
+                    "",
+                    -1,
+                    False,
+                    np.nan,
+                    np.nan,
+                    np.nan,
+                    offset,
+                    "n/a",
+                )
+            )
             continue
         p = parts.index(sym.part)
         c = cv[pose_frames[i], p]
@@ -312,11 +331,26 @@ def compare_movements(
             verdict = "match"
         else:
             verdict = "late" if offset > 0 else "early"
-        out.append(MovementResult(
-            i, sym.part, sym.direction, sym.level, sym.bend, int(kf[i]), int(pose_frames[i]), cdir, clev,
-            cbend, bool(agree), float(angle_between(c, target)), float(angle_between(r, target)),
-            float(angle_between(c, r)), offset, verdict,
-        ))
+        out.append(
+            MovementResult(
+                i,
+                sym.part,
+                sym.direction,
+                sym.level,
+                sym.bend,
+                int(kf[i]),
+                int(pose_frames[i]),
+                cdir,
+                clev,
+                cbend,
+                bool(agree),
+                float(angle_between(c, target)),
+                float(angle_between(r, target)),
+                float(angle_between(c, r)),
+                offset,
+                verdict,
+            )
+        )
     return out
 
 
@@ -368,7 +402,9 @@ def effort_differences(cand: dict, ref: dict) -> dict[str, dict]:
             mc, lc, hc = (float(x) for x in cand[name])
             mr, lr, hr = (float(x) for x in ref[name])
         except (TypeError, ValueError):
-            raise CompareError(f"effort {name} must be (median, lo, hi), got {cand[name]!r} and {ref[name]!r}") from None
+            raise CompareError(
+                f"effort {name} must be (median, lo, hi), got {cand[name]!r} and {ref[name]!r}"
+            ) from None
         lo, hi = lc - hr, hc - lr
         out[name] = {"difference": mc - mr, "lo": lo, "hi": hi, "consistent": bool(lo <= 0.0 <= hi)}
     return out

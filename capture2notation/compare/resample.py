@@ -14,6 +14,7 @@ selection never depends on floating-point rounding.
 
 from __future__ import annotations
 
+import itertools
 from fractions import Fraction
 
 import numpy as np
@@ -22,10 +23,10 @@ from ..errors import CompareError
 
 __all__ = [
     "as_rate",
-    "in_between_frames",
-    "keyframe_resample",
     "decimate",
     "hold_map",
+    "in_between_frames",
+    "keyframe_resample",
 ]
 
 
@@ -53,7 +54,7 @@ def as_rate(rate, source_rate=25) -> Fraction:
         raise CompareError(f"frame rate {rate!r} is not a number or fraction like 25/3") from None
     if r <= 0:
         raise CompareError(f"frame rate {rate!r} must be > 0 Hz")
-    if isinstance(source_rate, Fraction) or isinstance(source_rate, int):
+    if isinstance(source_rate, (Fraction, int)):
         src = Fraction(source_rate)
     else:
         src = Fraction(str(source_rate))
@@ -127,14 +128,12 @@ def keyframe_resample(n_frames: int, key_frames, rate, source_rate=25) -> np.nda
         raise CompareError(f"need at least one frame, got n_frames={n_frames}")
     keys = np.unique(np.asarray(list(key_frames), dtype=int))
     if keys.size and (keys[0] < 0 or keys[-1] >= n_frames):
-        raise CompareError(
-            f"key frames must lie in [0, {n_frames - 1}], got {keys[0]}..{keys[-1]}"
-        )
+        raise CompareError(f"key frames must lie in [0, {n_frames - 1}], got {keys[0]}..{keys[-1]}")
     if as_rate(rate, source_rate) > as_rate(source_rate, source_rate):
         raise CompareError(f"rate {rate} Hz exceeds the source rate {source_rate} Hz")
     keys = np.union1d(keys, [0, n_frames - 1]).astype(int)
     out = [int(keys[0])]
-    for ka, kb in zip(keys[:-1], keys[1:]):
+    for ka, kb in itertools.pairwise(keys):
         out.extend(in_between_frames(int(ka), int(kb), rate, source_rate))
         out.append(int(kb))
     return np.asarray(out, dtype=int)

@@ -5,14 +5,13 @@
 ``write_effort(result, outdir)`` writes ``effort.json`` and the plots.
 """
 
+from ..notation.effort import PRESETS, TIME_RANGE, WEIGHT_RANGE, Preset, progress, progress_speed, space_radius
 from .curves import ProgressCurve, progress_curve
 from .emotion import emotion_probabilities, same_or_different
 from .estimate import EffortResult, MovementEffort, estimate_effort, movement_windows
 from .fit import fit_logistic, fit_space
-from .model import TIME_RANGE, WEIGHT_RANGE, progress, progress_speed, space_radius
 from .pooled import PooledEffort, pooled_posterior
 from .posterior import Posterior, sample_posterior, sample_posteriors
-from .presets import PRESETS, Preset
 from .report import write_effort
 
 __all__ = [

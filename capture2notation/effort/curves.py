@@ -324,7 +324,7 @@ def refine_window(
     i1 = int(np.searchsorted(times, t_end + tol)) - 1
     on0 = 0 < i0 < i1
     on1 = i0 < i1 < times.size - 1
-    inside = speed[i0:max(i1, i0)]
+    inside = speed[i0 : max(i1, i0)]
     if inside.size == 0 or not np.any(np.isfinite(inside)):
         return float(t_start), float(t_end)
     # cosine between successive steps' displacements (T-2,): a movement's
@@ -346,11 +346,7 @@ def refine_window(
         # the rising flank may be followed far down (the logistic starts from
         # rest): its monotone fall, not a speed level, marks this movement
         while (
-            k >= 0
-            and times[k] >= lo - tol
-            and speed[k] > floor0
-            and speed[k] < speed[k + 1]
-            and turn[k] > MIN_TURN_COS
+            k >= 0 and times[k] >= lo - tol and speed[k] > floor0 and speed[k] < speed[k + 1] and turn[k] > MIN_TURN_COS
         ):
             k -= 1
         new0 = min(float(times[k + 1]), new0) if k + 1 < i0 else new0
@@ -469,9 +465,7 @@ def progress_curve(
     inner = ok & (tau_all > 1e-9) & (tau_all < 1 - 1e-9)
     idx = np.flatnonzero(inner)
     if idx.size < MIN_FRAMES:
-        raise EffortError(
-            f"{where}: only {idx.size} valid frames inside the movement, need at least {MIN_FRAMES}"
-        )
+        raise EffortError(f"{where}: only {idx.size} valid frames inside the movement, need at least {MIN_FRAMES}")
     path = np.vstack([v0, rel[idx], v1])  # (N+2, 3)
     radius = np.linalg.norm(path, axis=1)
     u = path / radius[:, None]

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import EffortError
-from .presets import PRESETS
+from ..notation.effort import PRESETS
 
 __all__ = [
     "FEATURES",
@@ -47,9 +47,7 @@ SPREAD = (0.2974, 0.0446, 0.1861, 0.1052)
 def preset_features() -> tuple[tuple[str, ...], np.ndarray]:
     """Emotion names and their (4,) feature vectors, shape (E, 4)."""
     names = tuple(PRESETS)
-    mat = np.array(
-        [[p.effort.time, p.effort.weight, p.effort.space, np.log(float(p.tempo))] for p in PRESETS.values()]
-    )
+    mat = np.array([[p.effort.time, p.effort.weight, p.effort.space, np.log(float(p.tempo))] for p in PRESETS.values()])
     return names, mat
 
 

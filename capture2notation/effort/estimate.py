@@ -127,7 +127,7 @@ def _neighbour_bounds(windows) -> list:
     """
     out = [(-np.inf, np.inf)] * len(windows)
     by_part: dict = {}
-    for i, (sym, t0, t1) in enumerate(windows):
+    for i, (sym, _t0, _t1) in enumerate(windows):
         by_part.setdefault(sym.part, []).append(i)
     for idx in by_part.values():
         idx = sorted(idx, key=lambda i: windows[i][1])

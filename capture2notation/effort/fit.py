@@ -13,7 +13,7 @@ import numpy as np
 from scipy import optimize, special, stats
 
 from ..errors import EffortError
-from .model import TIME_RANGE, WEIGHT_RANGE, progress
+from ..notation.effort import TIME_RANGE, WEIGHT_RANGE, progress
 
 __all__ = [
     "INWARD_DEPTH",
@@ -89,11 +89,13 @@ def _truncnorm_summary(mu: float, sd: float, lo: float, hi: float, mass: float =
     z_mass = special.ndtr(-za) - special.ndtr(-zb) if flip else special.ndtr(zb) - special.ndtr(za)
     if z_mass > 1e-12:
         if flip:
+
             def cdf(x):
                 return (special.ndtr(-za) - special.ndtr(-(x - mu) / sd)) / z_mass
 
             median = mu - sd * special.ndtri(special.ndtr(-za) - 0.5 * z_mass)
         else:
+
             def cdf(x):
                 return (special.ndtr((x - mu) / sd) - special.ndtr(za)) / z_mass
 
@@ -244,7 +246,9 @@ def fit_logistic_many(datasets, iterations: int = 60, sd_floor_sigma: float = 1e
         a11, a12, a22 = jtj[:, 0] * (1 + lam), jtj[:, 1], jtj[:, 2] * (1 + lam)
         det = a11 * a22 - a12 * a12
         with np.errstate(divide="ignore", invalid="ignore"):
-            step = -np.column_stack([a22 * jtr[:, 0] - a12 * jtr[:, 1], a11 * jtr[:, 1] - a12 * jtr[:, 0]]) / det[:, None]
+            step = (
+                -np.column_stack([a22 * jtr[:, 0] - a12 * jtr[:, 1], a11 * jtr[:, 1] - a12 * jtr[:, 0]]) / det[:, None]
+            )
         step = np.nan_to_num(step)
         trial = np.clip(p + step, lo + 1e-6, hi - 1e-6)
         c_new, jtj_new, jtr_new = evaluate(trial)

@@ -55,7 +55,7 @@ import numpy as np
 from scipy import special
 
 from ..errors import EffortError
-from .model import TIME_RANGE, WEIGHT_RANGE
+from ..notation.effort import TIME_RANGE, WEIGHT_RANGE
 
 __all__ = ["LOG_SIGMA_RANGE", "RHO_RANGE", "Batch", "log_gammainc"]
 
@@ -261,9 +261,15 @@ class Batch:
             if self.ar1:
                 sw, prev = np.sqrt(self._w), np.maximum(cols - 1, 0)
                 first = self._first[cols]
-                lay.update(first=first, expo=self._expo[cols], odd=np.round(self._expo[cols]) % 2 == 1, sw=sw[cols], sws=sw[cols] * self._s[cols],
-                           sw_prev=np.where(first, 0.0, sw[prev]),
-                           sws_prev=np.where(first, 0.0, sw[prev] * self._s[prev]))
+                lay.update(
+                    first=first,
+                    expo=self._expo[cols],
+                    odd=np.round(self._expo[cols]) % 2 == 1,
+                    sw=sw[cols],
+                    sws=sw[cols] * self._s[cols],
+                    sw_prev=np.where(first, 0.0, sw[prev]),
+                    sws_prev=np.where(first, 0.0, sw[prev] * self._s[prev]),
+                )
             if not cache:
                 return lay
             self._layouts[key] = lay
@@ -408,8 +414,9 @@ class Batch:
         theta = np.asarray(theta, dtype=float)
         # in row chunks of about a million (walker, sample) pairs
         step = max(1, (1 << 20) // self._samples_of[g].size)
-        chi2 = np.concatenate([self.chi2(theta[i:i + step], (g,), cache=False)[0]
-                               for i in range(0, theta.shape[0], step)])
+        chi2 = np.concatenate(
+            [self.chi2(theta[i : i + step], (g,), cache=False)[0] for i in range(0, theta.shape[0], step)]
+        )
         a = 0.5 * self.dof[g]
         lo, hi = np.exp(2.0 * np.asarray(LOG_SIGMA_RANGE))
         u0, u1 = chi2 / (2.0 * lo), chi2 / (2.0 * hi)

@@ -41,12 +41,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EffortError
+from ..notation.effort import TIME_RANGE, WEIGHT_RANGE
 from .fit import fit_logistic_many
 from .likelihood import LOG_SIGMA_RANGE, RHO_RANGE, Batch
-from .model import TIME_RANGE, WEIGHT_RANGE
 from .sampler import N_TAU, run_groups
 
-__all__ = ["LOG_SIGMA_RANGE", "N_TAU", "RHO_RANGE", "Posterior", "log_probability", "sample_posterior", "sample_posteriors"]
+__all__ = [
+    "LOG_SIGMA_RANGE",
+    "N_TAU",
+    "RHO_RANGE",
+    "Posterior",
+    "log_probability",
+    "sample_posterior",
+    "sample_posteriors",
+]
 
 log = logging.getLogger(__name__)
 
@@ -114,9 +122,12 @@ def log_probability(theta, tau, s, weight, onehot=None):
     theta = np.atleast_2d(theta)
     b, x0, lns = theta[:, 0], theta[:, 1], theta[:, 2]
     inside = (
-        (b > TIME_RANGE[0]) & (b < TIME_RANGE[1])
-        & (x0 > WEIGHT_RANGE[0]) & (x0 < WEIGHT_RANGE[1])
-        & (lns > LOG_SIGMA_RANGE[0]) & (lns < LOG_SIGMA_RANGE[1])
+        (b > TIME_RANGE[0])
+        & (b < TIME_RANGE[1])
+        & (x0 > WEIGHT_RANGE[0])
+        & (x0 < WEIGHT_RANGE[1])
+        & (lns > LOG_SIGMA_RANGE[0])
+        & (lns < LOG_SIGMA_RANGE[1])
     )
     out = np.full(theta.shape[0], -np.inf)
     if not inside.any():
@@ -224,23 +235,26 @@ def sample_posteriors(
         balls.append((min(0.01, 0.1 * fit.sd[0]), min(0.002, 0.1 * fit.sd[1])))
     if ar1:
         starts, balls = _rho_starts(batch, np.array(starts)), np.column_stack([balls, np.full(len(balls), 0.02)])
-    chains = run_groups(batch, starts, balls, rng, nwalkers=nwalkers, block=block, max_steps=max_steps,
-                        tau_rtol=tau_rtol)
+    chains = run_groups(
+        batch, starts, balls, rng, nwalkers=nwalkers, block=block, max_steps=max_steps, tau_rtol=tau_rtol
+    )
     out = []
     for g, ch in enumerate(chains):
         if not ch.converged:
             log.info("emcee did not converge in %d steps (tau = %s)", ch.steps, np.round(ch.tau, 1))
         th = ch.samples()
         lns = batch.draw_log_sigma(g, th, rng)
-        out.append(Posterior(
-            samples=np.column_stack([th[:, :2], lns]),
-            tau=np.asarray(ch.tau, dtype=float),
-            acceptance=ch.acceptance,
-            converged=ch.converged,
-            steps=ch.steps,
-            start=start3[g],
-            rho=th[:, 2] if ar1 else None,
-        ))
+        out.append(
+            Posterior(
+                samples=np.column_stack([th[:, :2], lns]),
+                tau=np.asarray(ch.tau, dtype=float),
+                acceptance=ch.acceptance,
+                converged=ch.converged,
+                steps=ch.steps,
+                start=start3[g],
+                rho=th[:, 2] if ar1 else None,
+            )
+        )
     return out
 
 
@@ -283,6 +297,14 @@ def sample_posterior(
     tau = np.asarray(tau, dtype=float)
     if groups is not None and np.shape(groups) != tau.shape:
         raise EffortError(f"groups must label each of the {tau.size} samples, got shape {np.shape(groups)}")
-    (post,) = sample_posteriors([(tau, s, weight, groups)], rng, free_ends=free_ends, nwalkers=nwalkers,
-                                block=block, max_steps=max_steps, tau_rtol=tau_rtol, ar1=ar1)
+    (post,) = sample_posteriors(
+        [(tau, s, weight, groups)],
+        rng,
+        free_ends=free_ends,
+        nwalkers=nwalkers,
+        block=block,
+        max_steps=max_steps,
+        tau_rtol=tau_rtol,
+        ar1=ar1,
+    )
     return post

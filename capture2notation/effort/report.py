@@ -16,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path, write_text
+from ..atomic import atomic_path, write_text
+from ..notation.effort import PRESETS, progress
 from .estimate import EffortResult
-from .model import progress
-from .presets import PRESETS
 
 __all__ = ["EFFORT_JSON", "POOLED_PNG", "PROGRESS_PNG", "plot_pooled", "plot_progress", "write_effort"]
 
@@ -98,7 +97,7 @@ def plot_progress(result: EffortResult, path, rng=0) -> Path:
         flag = "" if m.posterior.converged else " (not converged)"
         ax.set_title(f"{m.part} @ {m.start:g}\nb={b:.2f} x0={x0:.2f}{flag}", fontsize=7)
         ax.tick_params(labelsize=6)
-    for ax in list(axes.flat)[len(moves):]:
+    for ax in list(axes.flat)[len(moves) :]:
         ax.axis("off")
     if not moves:
         axes.flat[0].text(0.5, 0.5, "no movement measured", ha="center", va="center")
@@ -109,8 +108,14 @@ def plot_progress(result: EffortResult, path, rng=0) -> Path:
     fig.supxlabel("normalised time τ", fontsize=8)
     fig.supylabel("progress s", fontsize=8)
     # fixed margins instead of tight_layout (which measures every tick label)
-    fig.subplots_adjust(left=0.35 / (2.6 * cols) + 0.04, right=0.98, bottom=0.45 / (2.3 * rows) + 0.03,
-                        top=1.0 - 0.75 / (2.3 * rows), wspace=0.12, hspace=0.55)
+    fig.subplots_adjust(
+        left=0.35 / (2.6 * cols) + 0.04,
+        right=0.98,
+        bottom=0.45 / (2.3 * rows) + 0.03,
+        top=1.0 - 0.75 / (2.3 * rows),
+        wspace=0.12,
+        hspace=0.55,
+    )
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
     return Path(path)
@@ -130,12 +135,19 @@ def plot_pooled(result: EffortResult, path) -> Path:
         kw = {"color": c, "histtype": "step", "density": True, "bins": 40}
         axes[0, 0].hist(smp[:, 0], label=f"{label} (n={pooled.n_movements})", **kw)
         axes[1, 1].hist(smp[:, 1], **kw)
-        axes[1, 0].plot(smp[::max(1, smp.shape[0] // 1500), 0], smp[::max(1, smp.shape[0] // 1500), 1],
-                        ".", ms=1, alpha=0.3, color=c)
+        axes[1, 0].plot(
+            smp[:: max(1, smp.shape[0] // 1500), 0],
+            smp[:: max(1, smp.shape[0] // 1500), 1],
+            ".",
+            ms=1,
+            alpha=0.3,
+            color=c,
+        )
     for name, preset in PRESETS.items():
         axes[1, 0].plot(preset.effort.time, preset.effort.weight, "k+", ms=8)
-        axes[1, 0].annotate(name, (preset.effort.time, preset.effort.weight), fontsize=7,
-                            xytext=(3, 3), textcoords="offset points")
+        axes[1, 0].annotate(
+            name, (preset.effort.time, preset.effort.weight), fontsize=7, xytext=(3, 3), textcoords="offset points"
+        )
     axes[0, 0].set_xlabel("time b")
     axes[1, 1].set_xlabel("weight x0")
     axes[1, 0].set_xlabel("time b")

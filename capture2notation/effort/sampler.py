@@ -125,7 +125,7 @@ def integrated_time(x, c: float = 5.0) -> np.ndarray:
     m = 2 * _next_pow_two(n)
     per_group = max(1, _FFT_CHUNK // (m * int(np.prod(x.shape[2:]))))
     for a in range(0, G, per_group):
-        xs = x[:, a:a + per_group]
+        xs = x[:, a : a + per_group]
         f = np.fft.rfft(xs - xs.mean(axis=0), n=m, axis=0)
         acf = np.fft.irfft(f * np.conj(f), n=m, axis=0)[:n]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -133,7 +133,7 @@ def integrated_time(x, c: float = 5.0) -> np.ndarray:
         taus = 2.0 * np.cumsum(acf.mean(axis=2), axis=0) - 1.0  # (n, g, ndim)
         inside = np.arange(n)[:, None, None] < c * taus
         window = np.where(inside.any(axis=0), np.argmin(inside, axis=0), n - 1)
-        out[a:a + per_group] = np.take_along_axis(taus, window[None], axis=0)[0]
+        out[a : a + per_group] = np.take_along_axis(taus, window[None], axis=0)[0]
     return out
 
 
@@ -224,8 +224,10 @@ def run_groups(
         # a walker of the ball on a degenerate spot: restart it on a sound walker of its group
         ok = ~bad.reshape(G, W)
         if not ok.any(axis=1).all():
-            raise EffortError(f"posteriors {np.flatnonzero(~ok.any(axis=1)).tolist()}: every starting walker "
-                              "has zero probability (degenerate data?)")
+            raise EffortError(
+                f"posteriors {np.flatnonzero(~ok.any(axis=1)).tolist()}: every starting walker "
+                "has zero probability (degenerate data?)"
+            )
         for i in np.flatnonzero(bad):
             g = i // W
             j = g * W + int(rng.choice(np.flatnonzero(ok[g])))
@@ -242,12 +244,14 @@ def run_groups(
         n_a = len(active)
         run = min(block, max_steps - steps)
         sampler = emcee.EnsembleSampler(
-            n_a * W, D, functools.partial(batch.log_marginal, groups=tuple(active)), vectorize=True,
+            n_a * W,
+            D,
+            functools.partial(batch.log_marginal, groups=tuple(active)),
+            vectorize=True,
             moves=GroupedDEMove(n_a, W),
         )
         sampler.random_state = random.get_state()
-        state = sampler.run_mcmc(emcee.State(coords, log_prob=logp), run, progress=False,
-                                 skip_initial_state_check=True)
+        state = sampler.run_mcmc(emcee.State(coords, log_prob=logp), run, progress=False, skip_initial_state_check=True)
         random.set_state(sampler.random_state)
         steps += run
         blk = sampler.get_chain().reshape(run, n_a, W, D)

@@ -56,9 +56,7 @@ class Camera:
         R = np.asarray(self.R, float)
         t = np.asarray(self.t, float).reshape(-1)
         if K.shape != (3, 3) or R.shape != (3, 3) or t.shape != (3,):
-            raise FittingError(
-                f"camera needs K (3,3), R (3,3), t (3,); got {K.shape}, {R.shape}, {t.shape}"
-            )
+            raise FittingError(f"camera needs K (3,3), R (3,3), t (3,); got {K.shape}, {R.shape}, {t.shape}")
         if not (np.all(np.isfinite(K)) and np.all(np.isfinite(R)) and np.all(np.isfinite(t))):
             raise FittingError("camera K, R and t must be finite")
         if not np.allclose(R @ R.T, np.eye(3), atol=1e-5):
@@ -72,8 +70,13 @@ class Camera:
             object.__setattr__(self, k, v)
 
     @classmethod
-    def default(cls, image_size, hfov_deg: float = DEFAULT_HFOV_DEG,
-                distance: float = DEFAULT_DISTANCE, height: float = DEFAULT_HEIGHT) -> Camera:
+    def default(
+        cls,
+        image_size,
+        hfov_deg: float = DEFAULT_HFOV_DEG,
+        distance: float = DEFAULT_DISTANCE,
+        height: float = DEFAULT_HEIGHT,
+    ) -> Camera:
         """Upright, level camera on +y looking at the origin (DESIGN.md's front view).
 
         Parameters
@@ -98,6 +101,7 @@ class Camera:
     @classmethod
     def from_truth(cls, truth) -> Camera:
         """Camera of a truth sidecar (a ``Truth`` or a mapping with ``K``, ``R``, ``t``, ``image_size``)."""
+
         def get(name):
             if hasattr(truth, name):
                 return getattr(truth, name)

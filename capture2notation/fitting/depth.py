@@ -134,8 +134,9 @@ def _on_ray(ray: np.ndarray, centre: np.ndarray, radius: np.ndarray) -> tuple[np
     return near, far
 
 
-def arm_candidates(cam: Camera, shoulder: np.ndarray, elbow_px: np.ndarray, wrist_px: np.ndarray,
-                   upper: float, fore: float) -> tuple[np.ndarray, np.ndarray]:
+def arm_candidates(
+    cam: Camera, shoulder: np.ndarray, elbow_px: np.ndarray, wrist_px: np.ndarray, upper: float, fore: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Candidate elbow and wrist positions of one arm, camera coordinates.
 
     Parameters
@@ -260,8 +261,9 @@ def _remove_rest_offset(tw: np.ndarray, chain, hanging: np.ndarray, followers=()
         tw[:, f] = tw[:, e] + c
 
 
-def remove_leg_rest_offsets(model: PoseModel, cam: Camera, params: np.ndarray, names, tx: np.ndarray,
-                            tc: np.ndarray, tw: np.ndarray) -> np.ndarray:
+def remove_leg_rest_offsets(
+    model: PoseModel, cam: Camera, params: np.ndarray, names, tx: np.ndarray, tc: np.ndarray, tw: np.ndarray
+) -> np.ndarray:
     """World targets with the depth they give a straight standing leg taken out (a copy).
 
     The legs' counterpart of the arms' rest offset (:func:`_remove_rest_offset`):
@@ -294,8 +296,16 @@ def remove_leg_rest_offsets(model: PoseModel, cam: Camera, params: np.ndarray, n
         i_h, i_k, i_a = (names.index(n) for n in chain)
         m_h, m_k, m_a = (model.index(n) for n in chain)
         seen = (tc[:, i_h] > 0) & (tc[:, i_k] > 0) & (tc[:, i_a] > 0)
-        hanging = _hanging(cam, seen, tx[:, i_h], tx[:, i_k], tx[:, i_a], pts[:, m_h, 2],
-                           float(np.linalg.norm(model.offsets[m_k])), float(np.linalg.norm(model.offsets[m_a])))
+        hanging = _hanging(
+            cam,
+            seen,
+            tx[:, i_h],
+            tx[:, i_k],
+            tx[:, i_a],
+            pts[:, m_h, 2],
+            float(np.linalg.norm(model.offsets[m_k])),
+            float(np.linalg.norm(model.offsets[m_a])),
+        )
         followers = [names.index(f"{side}_{j}") for j in ("heel", "toe") if f"{side}_{j}" in names]
         _remove_rest_offset(tw, (i_h, i_k, i_a), hanging, followers)
     return tw
@@ -306,9 +316,18 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(n, 1e-9)
 
 
-def choose_arm_depths(model: PoseModel, cam: Camera, params: np.ndarray, names, tx: np.ndarray,
-                      tc: np.ndarray, tw: np.ndarray | None, image_z: np.ndarray | None, fps: float,
-                      opt: DepthOptions | None = None) -> tuple[np.ndarray, np.ndarray]:
+def choose_arm_depths(
+    model: PoseModel,
+    cam: Camera,
+    params: np.ndarray,
+    names,
+    tx: np.ndarray,
+    tc: np.ndarray,
+    tw: np.ndarray | None,
+    image_z: np.ndarray | None,
+    fps: float,
+    opt: DepthOptions | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Choose each arm's depth candidate per frame and write it into the world targets.
 
     Parameters
@@ -382,8 +401,10 @@ def choose_arm_depths(model: PoseModel, cam: Camera, params: np.ndarray, names, 
         if ok.any():
             w_up = _unit(np.nan_to_num(tw[:, i_e] - tw[:, i_s]))
             w_fore = _unit(np.nan_to_num(tw[:, i_w] - tw[:, i_e]))
-            cost = (np.sum((u_up - w_up[:, None]) ** 2, -1) * tc[:, [i_e]]
-                    + np.sum((u_fore - w_fore[:, None]) ** 2, -1) * tc[:, [i_w]]) / (2 * opt.sigma_world**2)
+            cost = (
+                np.sum((u_up - w_up[:, None]) ** 2, -1) * tc[:, [i_e]]
+                + np.sum((u_fore - w_fore[:, None]) ** 2, -1) * tc[:, [i_w]]
+            ) / (2 * opt.sigma_world**2)
             unary += np.where(ok[:, None], cost, 0.0)
         # Image landmarks' relative depth, as a fraction of the segment's length.
         if image_z is not None:
@@ -396,8 +417,10 @@ def choose_arm_depths(model: PoseModel, cam: Camera, params: np.ndarray, names, 
                 # The image landmarks' depth carries the same rest offset.
                 dz_up = dz_up - np.median(dz_up[hanging & okz])
                 dz_fore = dz_fore - np.median(dz_fore[hanging & okz])
-            cost = ((u_up[..., 2] - np.clip(np.nan_to_num(dz_up), -1, 1)[:, None]) ** 2
-                    + (u_fore[..., 2] - np.clip(np.nan_to_num(dz_fore), -1, 1)[:, None]) ** 2) / (2 * opt.sigma_image_z**2)
+            cost = (
+                (u_up[..., 2] - np.clip(np.nan_to_num(dz_up), -1, 1)[:, None]) ** 2
+                + (u_fore[..., 2] - np.clip(np.nan_to_num(dz_fore), -1, 1)[:, None]) ** 2
+            ) / (2 * opt.sigma_image_z**2)
             unary += np.where(okz[:, None], cost, 0.0)
         # Anatomy: no arm points back and up.
         v = _unit(W - S[:, None])
@@ -418,8 +441,9 @@ def choose_arm_depths(model: PoseModel, cam: Camera, params: np.ndarray, names, 
             unary += np.where(seen[:, None], opt.elbow * wrong, 0.0)
         # Continuity: the jump of the elbow and the wrist relative to the shoulder.
         rel_e, rel_w = E - S[:, None], W - S[:, None]
-        jump = (np.sum((rel_e[1:, None, :] - rel_e[:-1, :, None]) ** 2, -1)
-                + np.sum((rel_w[1:, None, :] - rel_w[:-1, :, None]) ** 2, -1))  # (T-1, from, to)
+        jump = np.sum((rel_e[1:, None, :] - rel_e[:-1, :, None]) ** 2, -1) + np.sum(
+            (rel_w[1:, None, :] - rel_w[:-1, :, None]) ** 2, -1
+        )  # (T-1, from, to)
         both = (seen[1:] & seen[:-1])[:, None, None]
         pair = np.where(both, jump / (2 * (opt.sigma_step * scale) ** 2), 0.0)
         path = viterbi(unary, pair)

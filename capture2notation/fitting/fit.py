@@ -112,7 +112,8 @@ _DIRECTIONS: tuple[tuple[str, str, float], ...] = (
 #: position, the direction root → end (weight) stands in for the two segments'
 #: directions, so the limb keeps the evidence of which side it points to.
 _SKIP_DIRECTIONS: tuple[tuple[str, str, str, float], ...] = tuple(
-    (f"{s}_{a}", f"{s}_{m}", f"{s}_{b}", 1.0) for s in ("right", "left")
+    (f"{s}_{a}", f"{s}_{m}", f"{s}_{b}", 1.0)
+    for s in ("right", "left")
     for a, m, b in (("hip", "knee", "ankle"), ("shoulder", "elbow", "wrist"))
 )
 
@@ -292,8 +293,9 @@ def _image_offsets(names, tx, tc, tw, camera: Camera, body: Body, floor: bool = 
         ratio[j] = (np.median(metres[ok]) if tw is not None else np.percentile(metres[ok], 90)) / base[j]
     scale_from = np.isfinite(ratio)
     for side in ("right", "left"):
-        upper = _upper_arm_length(camera, tx, tc, tw, depth, names.index(f"{side}_shoulder"),
-                                  names.index(f"{side}_elbow"))
+        upper = _upper_arm_length(
+            camera, tx, tc, tw, depth, names.index(f"{side}_shoulder"), names.index(f"{side}_elbow")
+        )
         elbow, wrist = JOINTS.index(f"{side}_elbow"), JOINTS.index(f"{side}_wrist")
         if np.isfinite(upper):
             ratio[elbow] = np.nanmax([ratio[elbow], upper / base[elbow]])
@@ -381,8 +383,9 @@ def _floor_start_depth(model: PoseModel, cam: Camera, names, tx, tc, tw, size_de
     return support_depth(feet, lowness, size_depth)
 
 
-def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool = True,
-                    floor: bool = False) -> np.ndarray:
+def _initial_params(
+    model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool = True, floor: bool = False
+) -> np.ndarray:
     """Starting parameters of every frame.
 
     The root is under the hip midpoint at a depth from the feet on the floor
@@ -400,9 +403,15 @@ def _initial_params(model: PoseModel, cam: Camera, names, tx, tc, tw, pose: bool
     f = cam.focal
     # Depth from lengths seen in the image: foreshortening only shortens, so
     # use a low quantile of the per-segment estimates.
-    segs = [("pelvis", "neck"), ("right_hip", "right_knee"), ("left_hip", "left_knee"),
-            ("right_knee", "right_ankle"), ("left_knee", "left_ankle"),
-            ("right_shoulder", "right_elbow"), ("left_shoulder", "left_elbow")]
+    segs = [
+        ("pelvis", "neck"),
+        ("right_hip", "right_knee"),
+        ("left_hip", "left_knee"),
+        ("right_knee", "right_ankle"),
+        ("left_knee", "left_ankle"),
+        ("right_shoulder", "right_elbow"),
+        ("left_shoulder", "left_elbow"),
+    ]
     est = []
     for a, b in segs:
         L = np.linalg.norm(rest[model.index(b)] - rest[model.index(a)])
@@ -476,10 +485,12 @@ def _world_yaw(names, tc, tw, cam: Camera, default: np.ndarray) -> np.ndarray:
     il, ir = names.index("left_hip"), names.index("right_hip")
     sl, sr = names.index("left_shoulder"), names.index("right_shoulder")
     shown = (tc > 0) & np.all(np.isfinite(tw), axis=2)
-    cands = ((tw[:, ir] - tw[:, il], np.all(np.isfinite(tw[:, [il, ir]]), axis=(1, 2))),
-             (tw[:, sr] - tw[:, sl], shown[:, sr] & shown[:, sl]),
-             (tw[:, sr], shown[:, sr]),
-             (-tw[:, sl], shown[:, sl]))
+    cands = (
+        (tw[:, ir] - tw[:, il], np.all(np.isfinite(tw[:, [il, ir]]), axis=(1, 2))),
+        (tw[:, sr] - tw[:, sl], shown[:, sr] & shown[:, sl]),
+        (tw[:, sr], shown[:, sr]),
+        (-tw[:, sl], shown[:, sl]),
+    )
     yaw = np.full(len(default), np.nan)
     for vec, ok in cands:
         right_w = np.nan_to_num(vec) @ cam.R  # camera axes -> world
@@ -493,11 +504,23 @@ def _world_yaw(names, tc, tw, cam: Camera, default: np.ndarray) -> np.ndarray:
 
 
 #: Chains lifted from 2D, parent target before child (see :func:`_lift`).
-_LIFT_CHAIN = (("pelvis", "neck"), ("neck", "right_shoulder"), ("neck", "left_shoulder"),
-               ("pelvis", "right_hip"), ("pelvis", "left_hip")) + tuple(
-    (f"{s}_{a}", f"{s}_{b}") for s in ("right", "left")
-    for a, b in (("shoulder", "elbow"), ("elbow", "wrist"), ("wrist", "hand_tip"),
-                 ("hip", "knee"), ("knee", "ankle"), ("ankle", "toe"))
+_LIFT_CHAIN = (
+    ("pelvis", "neck"),
+    ("neck", "right_shoulder"),
+    ("neck", "left_shoulder"),
+    ("pelvis", "right_hip"),
+    ("pelvis", "left_hip"),
+) + tuple(
+    (f"{s}_{a}", f"{s}_{b}")
+    for s in ("right", "left")
+    for a, b in (
+        ("shoulder", "elbow"),
+        ("elbow", "wrist"),
+        ("wrist", "hand_tip"),
+        ("hip", "knee"),
+        ("knee", "ankle"),
+        ("ankle", "toe"),
+    )
 )
 
 
@@ -569,9 +592,17 @@ def _check_2d(xy, confidence, world):
     return xy, conf, world, image_z
 
 
-def fit_keypoints(xy, confidence, fps: float, camera: Camera | None = None, world=None,
-                  body: Body | None = None, times=None, image_size=None,
-                  options: FitOptions | None = None) -> FitResult:
+def fit_keypoints(
+    xy,
+    confidence,
+    fps: float,
+    camera: Camera | None = None,
+    world=None,
+    body: Body | None = None,
+    times=None,
+    image_size=None,
+    options: FitOptions | None = None,
+) -> FitResult:
     """Fit 3D joint angles to a track of 2D BlazePose landmarks.
 
     Parameters
@@ -697,9 +728,17 @@ def _floored(res: FitResult, model: PoseModel) -> FitResult:
     return res.replace(joints=res.joints + shift, root=res.root + shift)
 
 
-def refine_focal(xy, confidence, fps, camera: Camera, world=None, body=None,
-                 options: FitOptions | None = None, hfovs=(40.0, 50.0, 60.0, 70.0, 85.0),
-                 max_frames: int = 24) -> Camera:
+def refine_focal(
+    xy,
+    confidence,
+    fps,
+    camera: Camera,
+    world=None,
+    body=None,
+    options: FitOptions | None = None,
+    hfovs=(40.0, 50.0, 60.0, 70.0, 85.0),
+    max_frames: int = 24,
+) -> Camera:
     """Choose the focal length that best explains the data.
 
     Fits up to `max_frames` evenly spaced frames for each candidate horizontal
@@ -762,8 +801,12 @@ def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor
     model = PoseModel(body, offsets)
     w_targets = np.array([t[2] for t in TARGETS_2D])
     use2 = w_targets > 0
-    terms = Terms(camera=camera, idx2=np.array([model.index(nm) for nm in np.array(names)[use2]]),
-                  obs2=tx[:, use2], w2=tc[:, use2] * w_targets[use2])
+    terms = Terms(
+        camera=camera,
+        idx2=np.array([model.index(nm) for nm in np.array(names)[use2]]),
+        obs2=tx[:, use2],
+        w2=tc[:, use2] * w_targets[use2],
+    )
     if tw is not None:
         pairs, dirs, wd = _direction_terms(names, tc, tw)
         terms.pairs = np.array([[model.index(a), model.index(b)] for a, b in pairs])
@@ -771,8 +814,9 @@ def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor
     return model, terms, (names, tx, tc, tw), use2
 
 
-def fit_track(track, camera: Camera | None = None, body: Body | None = None,
-              options: FitOptions | None = None) -> FitResult:
+def fit_track(
+    track, camera: Camera | None = None, body: Body | None = None, options: FitOptions | None = None
+) -> FitResult:
     """Fit a :class:`~capture2notation.keypoints.KeypointTrack`.
 
     Parameters
@@ -801,6 +845,14 @@ def fit_track(track, camera: Camera | None = None, body: Body | None = None,
         # BlazePose's world landmarks give a straight hanging limb a depth
         # of its own (:mod:`~capture2notation.fitting.depth`).
         options = FitOptions(depth=DepthOptions(rest_offset=True))
-    return fit_keypoints(xy, vis, float(track.fps), camera=camera, world=world, body=body,
-                         times=getattr(track, "times", None), image_size=tuple(np.asarray(track.image_size).tolist()),
-                         options=options)
+    return fit_keypoints(
+        xy,
+        vis,
+        float(track.fps),
+        camera=camera,
+        world=world,
+        body=body,
+        times=getattr(track, "times", None),
+        image_size=tuple(np.asarray(track.image_size).tolist()),
+        options=options,
+    )

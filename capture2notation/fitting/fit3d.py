@@ -22,9 +22,15 @@ __all__ = ["fit_points3d"]
 _J = len(JOINTS)
 
 
-def fit_points3d(points, confidence, fps: float, body: Body | None = None, times=None,
-                 virtual: dict[str, np.ndarray] | None = None,
-                 options: FitOptions | None = None) -> FitResult:
+def fit_points3d(
+    points,
+    confidence,
+    fps: float,
+    body: Body | None = None,
+    times=None,
+    virtual: dict[str, np.ndarray] | None = None,
+    options: FitOptions | None = None,
+) -> FitResult:
     """Fit joint angles to measured 3D joint positions (mocap, Kinect).
 
     Parameters
@@ -57,7 +63,9 @@ def fit_points3d(points, confidence, fps: float, body: Body | None = None, times
     points = np.asarray(points, float)
     conf = np.asarray(confidence, float)
     if points.ndim != 3 or points.shape[1:] != (_J, 3) or conf.shape != points.shape[:2]:
-        raise FittingError(f"fit_points3d needs points (T, {_J}, 3) and confidence (T, {_J}); got {points.shape}, {conf.shape}")
+        raise FittingError(
+            f"fit_points3d needs points (T, {_J}, 3) and confidence (T, {_J}); got {points.shape}, {conf.shape}"
+        )
     conf = np.where(np.all(np.isfinite(points), axis=-1), np.clip(np.nan_to_num(conf), 0, 1), 0.0)
     model = PoseModel(body, estimate_offsets(points, conf, body))
     idx = list(range(_J))

@@ -40,8 +40,9 @@ _MIN_CONF = 0.5
 TOL = 0.3
 
 
-def floor_depth(cam, px: np.ndarray, conf: np.ndarray, heights: np.ndarray, pelvis_height: float,
-                shift: np.ndarray | None = None) -> np.ndarray:
+def floor_depth(
+    cam, px: np.ndarray, conf: np.ndarray, heights: np.ndarray, pelvis_height: float, shift: np.ndarray | None = None
+) -> np.ndarray:
     """Depth (camera z) of the pelvis standing above each foot, per frame.
 
     Parameters
@@ -86,8 +87,7 @@ def floor_depth(cam, px: np.ndarray, conf: np.ndarray, heights: np.ndarray, pelv
     return np.where(ok & (depth > 0), depth, np.nan)
 
 
-def support_depth(feet: np.ndarray, lowness: np.ndarray, size_depth: np.ndarray,
-                  tol: float | None = TOL) -> np.ndarray:
+def support_depth(feet: np.ndarray, lowness: np.ndarray, size_depth: np.ndarray, tol: float | None = TOL) -> np.ndarray:
     """(T,) depth from the foot that stands on the floor.
 
     A foot in the air meets the floor plane somewhere else along its ray, so

@@ -56,11 +56,14 @@ def _rodrigues(axis: np.ndarray, ang: np.ndarray) -> np.ndarray:
     x, y, z = axis[..., 0], axis[..., 1], axis[..., 2]
     c, s = np.cos(ang), np.sin(ang)
     C = 1 - c
-    return np.stack([
-        np.stack([c + x * x * C, x * y * C - z * s, x * z * C + y * s], -1),
-        np.stack([y * x * C + z * s, c + y * y * C, y * z * C - x * s], -1),
-        np.stack([z * x * C - y * s, z * y * C + x * s, c + z * z * C], -1),
-    ], -2)
+    return np.stack(
+        [
+            np.stack([c + x * x * C, x * y * C - z * s, x * z * C + y * s], -1),
+            np.stack([y * x * C + z * s, c + y * y * C, y * z * C - x * s], -1),
+            np.stack([z * x * C - y * s, z * y * C + x * s, c + z * z * C], -1),
+        ],
+        -2,
+    )
 
 
 def _euler_in_limits(R: np.ndarray, lim: np.ndarray) -> np.ndarray:
@@ -172,8 +175,10 @@ def _limb(ang, P, G_parent, root, mid, end, sign, lim, continuous: bool):
     # reach a leg raised high forward and a little aside — and the bend's
     # frame is kept unless another points the segment clearly closer to `u`
     # after clipping.
-    euler = [_euler_in_limits(np.stack([np.cross(y_ax, z_ax), y_ax, z_ax], axis=-1), lim[r])
-             for y_ax in (np.where(bent[:, None], y_bend, y_rest), y_rest)]
+    euler = [
+        _euler_in_limits(np.stack([np.cross(y_ax, z_ax), y_ax, z_ax], axis=-1), lim[r])
+        for y_ax in (np.where(bent[:, None], y_bend, y_rest), y_rest)
+    ]
     rx = np.arcsin(np.clip(u_l[:, 1], -1.0, 1.0))
     for rx_k in (rx, np.pi - rx):
         c = np.cos(rx_k)
@@ -192,7 +197,9 @@ def _limb(ang, P, G_parent, root, mid, end, sign, lim, continuous: bool):
     ang[:, m, 0] = np.clip(flex, lim[m, 0, 0], lim[m, 0, 1])
 
 
-def _continuous(chosen: np.ndarray, u: np.ndarray, free: np.ndarray, best_cos: np.ndarray, lim: np.ndarray) -> np.ndarray:
+def _continuous(
+    chosen: np.ndarray, u: np.ndarray, free: np.ndarray, best_cos: np.ndarray, lim: np.ndarray
+) -> np.ndarray:
     """Root-joint angles that follow on from frame to frame.
 
     Chosen frame by frame, a straight limb's start jumped between twists and
@@ -261,9 +268,11 @@ def _rotation_1(e) -> list:
     """``Rz @ Ry @ Rx`` of one triple, as rows (see :func:`~capture2notation.body.euler_to_matrix`)."""
     cx, cy, cz = math.cos(e[0]), math.cos(e[1]), math.cos(e[2])
     sx, sy, sz = math.sin(e[0]), math.sin(e[1]), math.sin(e[2])
-    return [[cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx],
-            [sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx],
-            [-sy, cy * sx, cy * cx]]
+    return [
+        [cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx],
+        [sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx],
+        [-sy, cy * sx, cy * cx],
+    ]
 
 
 def _axis_cos(e, u) -> float:
@@ -288,9 +297,11 @@ def _swing_from(R: list, u) -> list:
     ang = math.atan2(math.sqrt(max(0.0, 1.0 - dot * dot)), dot)
     c, sn = math.cos(ang), math.sin(ang)
     C = 1 - c
-    K = [[c + x * x * C, x * y * C - z * sn, x * z * C + y * sn],
-         [y * x * C + z * sn, c + y * y * C, y * z * C - x * sn],
-         [z * x * C - y * sn, z * y * C + x * sn, c + z * z * C]]
+    K = [
+        [c + x * x * C, x * y * C - z * sn, x * z * C + y * sn],
+        [y * x * C + z * sn, c + y * y * C, y * z * C - x * sn],
+        [z * x * C - y * sn, z * y * C + x * sn, c + z * z * C],
+    ]
     return [[sum(K[i][k] * R[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
 
 

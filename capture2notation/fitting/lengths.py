@@ -29,8 +29,9 @@ _RATIO_BAND = (0.5, 2.0)
 RELATIVE_BAND = (0.85, 1.15)
 
 
-def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | None = None,
-                     relative: bool = False) -> np.ndarray:
+def estimate_offsets(
+    points: np.ndarray, confidence: np.ndarray, body: Body | None = None, relative: bool = False
+) -> np.ndarray:
     """Per-clip joint offsets from measured 3D joint positions.
 
     Parameters
@@ -75,8 +76,9 @@ def estimate_offsets(points: np.ndarray, confidence: np.ndarray, body: Body | No
     return offsets_from_ratios(ratio, body, relative)
 
 
-def offsets_from_ratios(ratio: np.ndarray, body: Body | None = None, relative: bool = False,
-                        scale_from: np.ndarray | None = None) -> np.ndarray:
+def offsets_from_ratios(
+    ratio: np.ndarray, body: Body | None = None, relative: bool = False, scale_from: np.ndarray | None = None
+) -> np.ndarray:
     """Offsets from measured length ratios to the model (NaN = not measured).
 
     Parameters

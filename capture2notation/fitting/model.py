@@ -95,9 +95,16 @@ class PoseModel:
         # The pelvis may turn without bound; wrap it instead of clipping.
         pel = np.nonzero(dof_joint == 0)[0] + 3
         lower[pel], upper[pel] = -np.inf, np.inf
-        for k, v in dict(names=tuple(names), parents=parents, offsets=np.asarray(offs),
-                         dof_joint=dof_joint, dof_axis=dof_axis, below=below,
-                         lower=lower, upper=upper).items():
+        for k, v in dict(
+            names=tuple(names),
+            parents=parents,
+            offsets=np.asarray(offs),
+            dof_joint=dof_joint,
+            dof_axis=dof_axis,
+            below=below,
+            lower=lower,
+            upper=upper,
+        ).items():
             object.__setattr__(self, k, v)
 
     def _scale(self, off_j: np.ndarray, child: str) -> float:
@@ -124,7 +131,9 @@ class PoseModel:
 
     def params(self, angles: np.ndarray, root: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`angles`: ``(T, 3 + D)`` from angles and root."""
-        return np.concatenate([np.asarray(root, float), np.asarray(angles, float)[:, self.dof_joint, self.dof_axis]], axis=1)
+        return np.concatenate(
+            [np.asarray(root, float), np.asarray(angles, float)[:, self.dof_joint, self.dof_axis]], axis=1
+        )
 
     def forward(self, params: np.ndarray, jacobian: bool = False):
         """Positions of all points, optionally with their Jacobian.

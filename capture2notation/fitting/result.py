@@ -53,7 +53,9 @@ class FitResult:
         expect = {"joints": (T, J, 3), "angles": (T, J, 3), "root": (T, 3), "confidence": (T, J)}
         for name, shape in expect.items():
             if np.shape(getattr(self, name)) != shape:
-                raise FittingError(f"{type(self).__name__}.{name} must have shape {shape}, got {np.shape(getattr(self, name))}")
+                raise FittingError(
+                    f"{type(self).__name__}.{name} must have shape {shape}, got {np.shape(getattr(self, name))}"
+                )
         if not (np.isfinite(self.fps) and self.fps > 0):
             raise FittingError(f"{type(self).__name__}.fps must be positive, got {self.fps!r}")
 

@@ -19,7 +19,7 @@ predecessor are solved again warm-started from the previous frame's pose.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -146,7 +146,7 @@ class FitOptions:
     polish_iterations: int = 3
     min_targets: int = 6
     min_confidence: float = 0.1
-    depth: DepthOptions | None = DepthOptions()
+    depth: DepthOptions | None = field(default_factory=DepthOptions)
 
 
 @dataclass
@@ -204,8 +204,9 @@ def _normal_equations(model: PoseModel, params, terms: Terms, opt: FitOptions, n
             # d(uv)/dp = f/z (R_row - c_row/z R_2), then chain with dp/dθ.
             R = cam.R
             dcam = R @ jac[:, terms.idx2]  # (T, N, 3, n)
-            duv = (dcam[:, :, :2] - (c[..., :2] / z[..., None])[..., None] * dcam[:, :, 2:3]) \
-                * (f[None, None, :, None] / z[..., None, None])
+            duv = (dcam[:, :, :2] - (c[..., :2] / z[..., None])[..., None] * dcam[:, :, 2:3]) * (
+                f[None, None, :, None] / z[..., None, None]
+            )
             Jr = duv * s[:, None, None, None]
         add(r, terms.w2, Jr)
 
@@ -287,8 +288,15 @@ def _prior_precision(model: PoseModel, fps: float, opt: FitOptions, T: int):
 CHUNK, OVERLAP = 400, 16
 
 
-def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
-          iterations: int, frozen: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def solve(
+    model: PoseModel,
+    params: np.ndarray,
+    terms: Terms,
+    fps: float,
+    opt: FitOptions,
+    iterations: int,
+    frozen: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Solve long clips in overlapping chunks of :data:`CHUNK` frames; see :func:`solve_batch`."""
     T = params.shape[0]
     if T <= CHUNK:
@@ -309,8 +317,15 @@ def solve(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: F
     return out, cost
 
 
-def solve_batch(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions,
-                iterations: int, frozen: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def solve_batch(
+    model: PoseModel,
+    params: np.ndarray,
+    terms: Terms,
+    fps: float,
+    opt: FitOptions,
+    iterations: int,
+    frozen: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Vectorised Levenberg–Marquardt over all frames; returns (params, data cost per frame).
 
     The first two thirds of the iterations use a hundredth of the temporal
@@ -402,8 +417,15 @@ def to_result(model, params, fps, times, conf, usable) -> FitResult:
     times = np.arange(T) / fps if times is None else np.asarray(times, float)
     if times.shape != (T,):
         raise FittingError(f"times must have shape ({T},), got {times.shape}")
-    return FitResult(fps=float(fps), times=times, joints=joints, angles=angles, root=root,
-                     confidence=conf, offsets=model.offsets[:_J].copy())
+    return FitResult(
+        fps=float(fps),
+        times=times,
+        joints=joints,
+        angles=angles,
+        root=root,
+        confidence=conf,
+        offsets=model.offsets[:_J].copy(),
+    )
 
 
 def check_fps(fps):

@@ -58,8 +58,9 @@ def _second_difference(T: int):
     return diags([np.ones(T - 2), -2.0 * np.ones(T - 2), np.ones(T - 2)], [0, 1, 2], shape=(T - 2, T))
 
 
-def smooth_root(model: PoseModel, params: np.ndarray, terms: Terms, fps: float,
-                opt: FitOptions, joints: tuple[str, ...] = COUPLED) -> np.ndarray:
+def smooth_root(
+    model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions, joints: tuple[str, ...] = COUPLED
+) -> np.ndarray:
     """One Gauss–Newton step of the root and leg trajectories under their smoothness prior.
 
     Parameters
@@ -102,8 +103,9 @@ def smooth_root(model: PoseModel, params: np.ndarray, terms: Terms, fps: float,
         g = g[:, order]
         Hra = H[:, :k, k:]
         # Haa⁻¹ [H_ar | g_a] in one batched solve.
-        X[sl] = np.linalg.solve(H[:, k:, k:] + 1e-6 * np.eye(n - k),
-                                np.concatenate([Hra.transpose(0, 2, 1), g[:, k:, None]], axis=2))
+        X[sl] = np.linalg.solve(
+            H[:, k:, k:] + 1e-6 * np.eye(n - k), np.concatenate([Hra.transpose(0, 2, 1), g[:, k:, None]], axis=2)
+        )
         S[sl] = H[:, :k, :k] - Hra @ X[sl][..., :k]
         s[sl] = g[:, :k] - (Hra @ X[sl][..., k:])[..., 0]
     # The temporal term (θ_t − (θ_{t−1} + θ_{t+1}) / 2) is half a second difference.

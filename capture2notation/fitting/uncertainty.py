@@ -40,8 +40,7 @@ __all__ = ["direction_spread", "spread_factor"]
 _J = len(JOINTS)
 
 
-def direction_spread(model: PoseModel, params: np.ndarray, terms: Terms, fps: float,
-                     opt: FitOptions) -> np.ndarray:
+def direction_spread(model: PoseModel, params: np.ndarray, terms: Terms, fps: float, opt: FitOptions) -> np.ndarray:
     """Angular spread (degrees) of the segment ending at each joint, per frame.
 
     Parameters

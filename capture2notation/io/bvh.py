@@ -14,7 +14,7 @@ Positions are converted to our world frame: the up axis is detected from the
 rest skeleton (BVH is usually y-up), the length unit is chosen among metres,
 centimetres, millimetres, inches and CMU units so the figure is 1.2–2.2 m tall
 (otherwise it is scaled to 1.70 m with a warning); see
-:func:`capture2notation.io.motion.normalise_world` for floor and facing.
+:func:`capture2notation.fitting.motion.normalise_world` for floor and facing.
 
 Writing produces our skeleton in a y-up file (as Blender, MotionBuilder and
 Mixamo expect), centimetres by default, every joint with channels
@@ -31,12 +31,21 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import write_text
 from ..body import JOINTS, Body
 from ..errors import MotionFileError
-from .atomic import write_text
 
-__all__ = ["BvhSkeleton", "NAME_TABLE", "parse_bvh", "bvh_positions", "map_joints", "read_bvh_points",
-           "read_own_bvh", "write_bvh", "write_motion_bvh"]
+__all__ = [
+    "NAME_TABLE",
+    "BvhSkeleton",
+    "bvh_positions",
+    "map_joints",
+    "parse_bvh",
+    "read_bvh_points",
+    "read_own_bvh",
+    "write_bvh",
+    "write_motion_bvh",
+]
 
 log = logging.getLogger(__name__)
 
@@ -48,8 +57,17 @@ _SIDED = {
     "shoulder": ["{s}arm", "{s}upperarm", "{s}shoulder", "{c}shoulder"],
     "elbow": ["{s}forearm", "{s}elbow", "{s}lowerarm", "{c}elbow"],
     "wrist": ["{s}hand", "{s}wrist", "{c}wrist", "{c}hand"],
-    "hand_tip": ["{s}handmiddle3end", "{s}handmiddle4", "{s}handindex3end", "{s}handindex1",
-                 "{s}fingerbase", "{s}wristend", "{s}handend", "{s}handtip", "{s}handthumb1"],
+    "hand_tip": [
+        "{s}handmiddle3end",
+        "{s}handmiddle4",
+        "{s}handindex3end",
+        "{s}handindex1",
+        "{s}fingerbase",
+        "{s}wristend",
+        "{s}handend",
+        "{s}handtip",
+        "{s}handthumb1",
+    ],
     "hip": ["{s}upleg", "{s}upperleg", "{s}thigh", "{s}hip", "{c}hip"],
     "knee": ["{s}leg", "{s}lowerleg", "{s}shin", "{s}knee", "{c}knee"],
     "ankle": ["{s}foot", "{s}ankle", "{c}ankle", "{c}foot"],
@@ -141,8 +159,11 @@ def parse_bvh(path) -> BvhSkeleton:
             raise MotionFileError(f"{path}:{ln}: expected a number for {what}, found {tok!r}") from None
 
     take("HIERARCHY")
-    names, parents, offsets, channels = [], [], [], []
-    stack = []
+    names: list[str] = []
+    parents: list[int] = []
+    offsets: list = []
+    channels: list = []
+    stack: list[int] = []
     tok, ln = take("ROOT")
     kind = "ROOT"
     while True:
@@ -273,9 +294,11 @@ def _up_and_unit(pos: np.ndarray, pelvis: int, top: int) -> tuple[np.ndarray, fl
     up_vec = np.median(pos[:, top] - pos[:, pelvis], axis=0)
     up = int(np.argmax(np.abs(up_vec)))
     sign = 1.0 if up_vec[up] >= 0 else -1.0
-    to_z = {0: np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0]]),  # x up -> z
-            1: np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]]),  # y up -> z
-            2: np.eye(3)}[up].astype(float)
+    to_z = {
+        0: np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0]]),  # x up -> z
+        1: np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]]),  # y up -> z
+        2: np.eye(3),
+    }[up].astype(float)
     if sign < 0:
         to_z = np.diag([1.0, -1.0, -1.0]) @ to_z
     extent = pos[..., up].max(axis=1) - pos[..., up].min(axis=1)
@@ -406,11 +429,12 @@ def read_own_bvh(skel: BvhSkeleton):
     offsets : (J, 3) ndarray
         Metres, our world axes.
     """
-    if list(skel.names[: 1]) != [JOINTS[0]] or not set(JOINTS) <= set(skel.names):
+    if list(skel.names[:1]) != [JOINTS[0]] or not set(JOINTS) <= set(skel.names):
         return None
     want_root = ["xposition", "yposition", "zposition", "yrotation", "zrotation", "xrotation"]
-    if any(skel.channels[i] != (want_root if i == 0 else want_root[3:])
-           for i, n in enumerate(skel.names) if n in JOINTS):
+    if any(
+        skel.channels[i] != (want_root if i == 0 else want_root[3:]) for i, n in enumerate(skel.names) if n in JOINTS
+    ):
         return None
     idx = [skel.names.index(j) for j in JOINTS]
     starts = np.cumsum([0] + [len(c) for c in skel.channels])[:-1]
@@ -419,7 +443,9 @@ def read_own_bvh(skel: BvhSkeleton):
     thigh = np.linalg.norm(offsets_file[JOINTS.index("right_knee")])
     unit = 0.01 if thigh > 5.0 else 1.0
     T = skel.motion.shape[0]
-    ch = np.stack([skel.motion[:, starts[i] + (3 if i == 0 else 0) : starts[i] + (6 if i == 0 else 3)] for i in idx], axis=1)
+    ch = np.stack(
+        [skel.motion[:, starts[i] + (3 if i == 0 else 0) : starts[i] + (6 if i == 0 else 3)] for i in idx], axis=1
+    )
     ch = np.deg2rad(ch)  # (T, J, 3) = (rz, -ry, rx)
     angles = np.stack([ch[..., 2], -ch[..., 1], ch[..., 0]], axis=-1)
     root = skel.motion[:, starts[0] : starts[0] + 3] @ _Z_TO_Y * unit
@@ -434,8 +460,15 @@ def read_own_bvh(skel: BvhSkeleton):
 _Z_TO_Y = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 
 
-def write_bvh(path, angles: np.ndarray, root: np.ndarray, fps: float, offsets: np.ndarray | None = None,
-              body: Body | None = None, unit: str = "cm") -> Path:
+def write_bvh(
+    path,
+    angles: np.ndarray,
+    root: np.ndarray,
+    fps: float,
+    offsets: np.ndarray | None = None,
+    body: Body | None = None,
+    unit: str = "cm",
+) -> Path:
     """Write a motion of our skeleton as BVH (atomically).
 
     Parameters
@@ -540,5 +573,5 @@ def _hold(root: np.ndarray, ok: np.ndarray) -> np.ndarray:
     idx = np.where(ok, np.arange(len(ok)), 0)
     np.maximum.accumulate(idx, out=idx)
     first = int(np.argmax(ok))
-    idx[: first] = first
+    idx[:first] = first
     return out[idx]

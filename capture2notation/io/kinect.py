@@ -25,23 +25,50 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import write_text
 from ..body import JOINTS, joint_index
 from ..errors import MotionFileError
-from .atomic import write_text
 
-__all__ = ["KINECT_JOINTS", "KINECT_TO_JOINT", "TRACKING_CONFIDENCE", "read_kinect_csv",
-           "write_kinect_csv", "camera_to_world", "world_to_camera", "kinect_points"]
+__all__ = [
+    "KINECT_JOINTS",
+    "KINECT_TO_JOINT",
+    "TRACKING_CONFIDENCE",
+    "camera_to_world",
+    "kinect_points",
+    "read_kinect_csv",
+    "world_to_camera",
+    "write_kinect_csv",
+]
 
 log = logging.getLogger(__name__)
 
 #: Kinect SDK v2 ``JointType`` order (LabanEditor's names in comments).
 KINECT_JOINTS: tuple[str, ...] = (
-    "SpineBase", "SpineMid", "Neck", "Head",  # spineB spineM neck head
-    "ShoulderLeft", "ElbowLeft", "WristLeft", "HandLeft",
-    "ShoulderRight", "ElbowRight", "WristRight", "HandRight",
-    "HipLeft", "KneeLeft", "AnkleLeft", "FootLeft",
-    "HipRight", "KneeRight", "AnkleRight", "FootRight",
-    "SpineShoulder", "HandTipLeft", "ThumbLeft", "HandTipRight", "ThumbRight",
+    "SpineBase",
+    "SpineMid",
+    "Neck",
+    "Head",  # spineB spineM neck head
+    "ShoulderLeft",
+    "ElbowLeft",
+    "WristLeft",
+    "HandLeft",
+    "ShoulderRight",
+    "ElbowRight",
+    "WristRight",
+    "HandRight",
+    "HipLeft",
+    "KneeLeft",
+    "AnkleLeft",
+    "FootLeft",
+    "HipRight",
+    "KneeRight",
+    "AnkleRight",
+    "FootRight",
+    "SpineShoulder",
+    "HandTipLeft",
+    "ThumbLeft",
+    "HandTipRight",
+    "ThumbRight",
 )
 
 #: Kinect joint -> (our joint or virtual point, confidence factor).  The
@@ -53,10 +80,20 @@ KINECT_TO_JOINT: dict[str, tuple[str, float]] = {
     "SpineMid": ("waist", 0.3),
     "SpineShoulder": ("neck", 1.0),
     "Head": ("head_centre", 1.0),
-    **{f"{k}{s.title()}": (f"{s}_{o}", 1.0)
-       for s in ("left", "right")
-       for k, o in (("Shoulder", "shoulder"), ("Elbow", "elbow"), ("Wrist", "wrist"), ("HandTip", "hand_tip"),
-                    ("Hip", "hip"), ("Knee", "knee"), ("Ankle", "ankle"), ("Foot", "toe"))},
+    **{
+        f"{k}{s.title()}": (f"{s}_{o}", 1.0)
+        for s in ("left", "right")
+        for k, o in (
+            ("Shoulder", "shoulder"),
+            ("Elbow", "elbow"),
+            ("Wrist", "wrist"),
+            ("HandTip", "hand_tip"),
+            ("Hip", "hip"),
+            ("Knee", "knee"),
+            ("Ankle", "ankle"),
+            ("Foot", "toe"),
+        )
+    },
 }
 
 #: Confidence of each tracking state (0 not tracked, 1 inferred, 2 tracked).
@@ -105,19 +142,23 @@ def read_kinect_csv(path):
             vals = np.array([float(f) for f in fields[: 1 + 4 * _N]])
         except ValueError:
             bad = next(f for f in fields if not _is_float(f))
-            raise MotionFileError(f"{path}:{ln}: expected numbers, found {bad!r} (the file has no header line)") from None
+            raise MotionFileError(
+                f"{path}:{ln}: expected numbers, found {bad!r} (the file has no header line)"
+            ) from None
         state = vals[1:].reshape(_N, 4)[:, 3]
         if np.any(~np.isin(state, (0, 1, 2))):
             j = int(np.nonzero(~np.isin(state, (0, 1, 2)))[0][0])
-            raise MotionFileError(f"{path}:{ln}: tracking state of {KINECT_JOINTS[j]} is {float(state[j]):g}, expected 0, 1 or 2")
+            raise MotionFileError(
+                f"{path}:{ln}: tracking state of {KINECT_JOINTS[j]} is {float(state[j]):g}, expected 0, 1 or 2"
+            )
         stamps.append(vals[0])
         rows.append(vals[1:].reshape(_N, 4))
     if not rows:
         raise MotionFileError(f"{path}: no skeleton rows")
-    stamps = np.asarray(stamps)
+    ticks = np.asarray(stamps)
     data = np.stack(rows)
-    scale = 1.0 / _TICKS_PER_SECOND if stamps.max() > _TICKS_THRESHOLD else 1e-3
-    t = (stamps - stamps[0]) * scale
+    scale = 1.0 / _TICKS_PER_SECOND if ticks.max() > _TICKS_THRESHOLD else 1e-3
+    t = (ticks - ticks[0]) * scale
     if np.any(np.diff(t) < 0):
         k = int(np.nonzero(np.diff(t) < 0)[0][0])
         raise MotionFileError(f"{path}: timestamps go backwards at data row {k + 2}")
@@ -132,7 +173,7 @@ def read_kinect_csv(path):
     c = TRACKING_CONFIDENCE[state]
     xyz = np.where((state > 0)[..., None], data[..., :3], np.nan)
     pos[idx], conf[idx] = xyz, c  # a repeated grid slot keeps the later row
-    if T > len(rows):
+    if len(rows) < T:
         log.info("%s: %d dropped frames left as NaN", path, T - len(np.unique(idx)))
     return np.arange(T) / fps, pos, conf, fps
 
@@ -204,7 +245,9 @@ def write_kinect_csv(path, times: np.ndarray, positions: np.ndarray, states: np.
     positions = np.asarray(positions, float)
     states = np.asarray(states).astype(int)
     if positions.shape != (len(times), _N, 3) or states.shape != (len(times), _N):
-        raise MotionFileError(f"write_kinect_csv needs positions (T, 25, 3) and states (T, 25); got {positions.shape}, {states.shape}")
+        raise MotionFileError(
+            f"write_kinect_csv needs positions (T, 25, 3) and states (T, 25); got {positions.shape}, {states.shape}"
+        )
     ticks = np.round(times * _TICKS_PER_SECOND).astype(np.int64) + 10**8
     out = []
     for t, p, s in zip(ticks, np.nan_to_num(positions), states):

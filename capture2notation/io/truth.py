@@ -36,8 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path
 from ..errors import MotionFileError
-from .atomic import atomic_path
 
 __all__ = ["TRUTH_FIELDS", "Truth", "read_truth", "write_truth"]
 
@@ -101,9 +101,7 @@ def _validate(arrays: dict, where: str) -> dict:
     if missing:
         raise MotionFileError(f"{where}: truth sidecar lacks field(s) {', '.join(missing)}")
     if extra:
-        raise MotionFileError(
-            f"{where}: unknown truth field(s) {', '.join(extra)}; expected {', '.join(TRUTH_FIELDS)}"
-        )
+        raise MotionFileError(f"{where}: unknown truth field(s) {', '.join(extra)}; expected {', '.join(TRUTH_FIELDS)}")
     sizes: dict[str, int] = {}
     out = {}
     for name, pattern in TRUTH_FIELDS.items():
@@ -122,9 +120,7 @@ def _validate(arrays: dict, where: str) -> dict:
                 raise MotionFileError(f"{where}: field {name} must be numeric, got {type(value).__name__}") from None
         if pattern is not None:
             if arr.ndim != len(pattern):
-                raise MotionFileError(
-                    f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)}"
-                )
+                raise MotionFileError(f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)}")
             for dim, want in zip(arr.shape, pattern):
                 if isinstance(want, str):
                     if sizes.setdefault(want, dim) != dim:

@@ -14,13 +14,13 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import cv2
 import numpy as np
 
+from ..atomic import atomic_path
 from ..errors import VideoError
-from .atomic import atomic_path
 
 __all__ = [
     "IMAGE_EXTENSIONS",
@@ -173,7 +173,9 @@ def _iter_file(info: VideoInfo, start: int, stop: int | None) -> Iterator[Frame]
             ok, image = cap.read()
             if not ok or image is None:
                 if index < info.frame_count:
-                    _stop_early(info.path, index, f"frame cannot be decoded; the file declares {info.frame_count} frames")
+                    _stop_early(
+                        info.path, index, f"frame cannot be decoded; the file declares {info.frame_count} frames"
+                    )
                 elif index == 0:
                     raise VideoError(f"{info.path}: no frame could be read")
                 return
@@ -256,23 +258,27 @@ class VideoWriter:
         self.fps = float(fps)
         self.size = (int(size[0]), int(size[1]))
         self.frames_written = 0
-        self._ctx = None
-        self._writer = None
-        self._ffmpeg = None
+        self._ctx: Any = None  # the atomic_path context while open
+        self._writer: Any = None  # cv2.VideoWriter (AVI, odd sizes)
+        self._ffmpeg: Any = None  # imageio-ffmpeg's H.264 generator
 
     def __enter__(self) -> VideoWriter:
         suffix = self.path.suffix.lower()
         if suffix not in self._FOURCC:
-            raise VideoError(f"{self.path}: cannot write video with extension {suffix!r}; expected one of {sorted(self._FOURCC)}")
+            raise VideoError(
+                f"{self.path}: cannot write video with extension {suffix!r}; expected one of {sorted(self._FOURCC)}"
+            )
         self._ctx = atomic_path(self.path)
         tmp = self._ctx.__enter__()
         if suffix != ".avi" and self.size[0] % 2 == 0 and self.size[1] % 2 == 0:
             self._ffmpeg = _h264_writer(tmp, self.fps, self.size)
             return self
-        self._writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*self._FOURCC[suffix]), self.fps, self.size)
+        self._writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter.fourcc(*self._FOURCC[suffix]), self.fps, self.size)
         if not self._writer.isOpened():
             self._ctx.__exit__(VideoError, None, None)
-            raise VideoError(f"{self.path}: OpenCV cannot open a video writer ({self._FOURCC[suffix]}, {self.fps} fps, {self.size})")
+            raise VideoError(
+                f"{self.path}: OpenCV cannot open a video writer ({self._FOURCC[suffix]}, {self.fps} fps, {self.size})"
+            )
         return self
 
     def write(self, image: np.ndarray) -> None:
@@ -302,8 +308,14 @@ def _h264_writer(path: Path, fps: float, size: tuple[int, int]):
     import imageio_ffmpeg
 
     gen = imageio_ffmpeg.write_frames(
-        str(path), size, fps=fps, codec="libx264", pix_fmt_in="bgr24", pix_fmt_out="yuv420p",
-        macro_block_size=1, ffmpeg_log_level="error",
+        str(path),
+        size,
+        fps=fps,
+        codec="libx264",
+        pix_fmt_in="bgr24",
+        pix_fmt_out="yuv420p",
+        macro_block_size=1,
+        ffmpeg_log_level="error",
         # veryfast keeps encoding well above the capture's frame rate; faststart
         # moves the index to the front so a browser can play while loading.
         output_params=["-preset", "veryfast", "-movflags", "+faststart"],

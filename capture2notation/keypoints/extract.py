@@ -83,7 +83,9 @@ def extract_frames(
     KeypointError
         Unknown backend, no frames, or frames of changing size.
     """
-    est = estimator if estimator is not None else _make_backend(backend, model, threads, smooth, markers, bool(flip_test))
+    est = (
+        estimator if estimator is not None else _make_backend(backend, model, threads, smooth, markers, bool(flip_test))
+    )
     if hasattr(est, "smooth"):
         est.smooth = bool(smooth)
     if flip_test is not None and hasattr(est, "flip_test"):

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import cv2
 import numpy as np
@@ -23,7 +24,42 @@ from ..errors import KeypointError
 from .blazepose import PoseEstimate
 from .track import NUM_LANDMARKS, landmark_index
 
-__all__ = ["MarkerSpec", "MarkerTracker", "default_markers", "detect_blobs", "read_marker_specs"]
+__all__ = [
+    "MARKER_HSV",
+    "MARKER_JOINTS",
+    "MarkerSpec",
+    "MarkerTracker",
+    "default_markers",
+    "detect_blobs",
+    "read_marker_specs",
+]
+
+
+#: Joints that carry a marker.
+MARKER_JOINTS: tuple[str, ...] = (
+    "head",
+    "neck",
+    "right_shoulder",
+    "right_elbow",
+    "right_wrist",
+    "right_hand_tip",
+    "left_shoulder",
+    "left_elbow",
+    "left_wrist",
+    "left_hand_tip",
+    "right_hip",
+    "right_knee",
+    "right_ankle",
+    "right_toe",
+    "left_hip",
+    "left_knee",
+    "left_ankle",
+    "left_toe",
+)
+#: OpenCV HSV (H in 0-179, S, V) of each marker: hue 10·((7·k) mod 18).
+MARKER_HSV: MappingProxyType = MappingProxyType(
+    {j: (10 * ((7 * k) % 18), 255, 255) for k, j in enumerate(MARKER_JOINTS)}
+)
 
 
 @dataclass(frozen=True)
@@ -52,9 +88,7 @@ class MarkerSpec:
             object.__setattr__(self, name, v)
 
     @classmethod
-    def from_colour(
-        cls, landmark, bgr, hue_tol: int = 6, min_saturation: int = 80, min_value: int = 60
-    ) -> MarkerSpec:
+    def from_colour(cls, landmark, bgr, hue_tol: int = 6, min_saturation: int = 80, min_value: int = 60) -> MarkerSpec:
         """A spec around a saturated BGR colour (``landmark`` may be a name or index)."""
         index = landmark_index(landmark) if isinstance(landmark, str) else int(landmark)
         pixel = np.uint8([[list(bgr)]])
@@ -71,7 +105,7 @@ class MarkerSpec:
 
 
 def default_markers(hue_tol: int = 4) -> list[MarkerSpec]:
-    """The renderer's marker set, from ``synthetic.render.markers.MARKER_HSV``.
+    """The marker set of :data:`MARKER_HSV` (what the renderer's ``markers`` style draws).
 
     Each rendered joint that is also a BlazePose landmark (shoulders, elbows,
     wrists, hand tips → index, hips, knees, ankles, toes → foot index; see
@@ -81,13 +115,6 @@ def default_markers(hue_tol: int = 4) -> list[MarkerSpec]:
     """
     from ..body.skeleton import JOINT_TO_BLAZEPOSE
 
-    try:
-        from synthetic.render.markers import MARKER_HSV
-    except ImportError as exc:
-        raise KeypointError(
-            "no marker colours given and the renderer's synthetic.render.markers is unavailable; "
-            "pass markers=[MarkerSpec(...), ...]"
-        ) from exc
     specs = []
     for joint, (h, _s, _v) in MARKER_HSV.items():
         if joint in JOINT_TO_BLAZEPOSE:
@@ -131,7 +158,9 @@ def read_marker_specs(path) -> list[MarkerSpec]:
             else:
                 specs.append(MarkerSpec(index, tuple(e["hsv_low"]), tuple(e["hsv_high"])))
         except (KeyError, TypeError, ValueError, KeypointError) as exc:
-            raise KeypointError(f"{path}: marker entry {k} ({e!r}): {exc}; expected landmark and hsv_low/hsv_high or bgr") from exc
+            raise KeypointError(
+                f"{path}: marker entry {k} ({e!r}): {exc}; expected landmark and hsv_low/hsv_high or bgr"
+            ) from exc
     return specs
 
 

@@ -33,8 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path, write_text
 from ..errors import ModelError
-from ..io.atomic import atomic_path, write_text
 
 __all__ = [
     "INPUT_SHAPE",
@@ -203,7 +203,9 @@ def _extract_tflite(wheel: Path, dest: Path) -> Path:
         with zipfile.ZipFile(wheel) as zf:
             data = zf.read(TFLITE_MEMBER)
     except (OSError, KeyError, zipfile.BadZipFile) as exc:
-        raise ModelError(f"{wheel}: cannot read {TFLITE_MEMBER} ({exc}); expected a mediapipe=={MEDIAPIPE_VERSION} wheel") from exc
+        raise ModelError(
+            f"{wheel}: cannot read {TFLITE_MEMBER} ({exc}); expected a mediapipe=={MEDIAPIPE_VERSION} wheel"
+        ) from exc
     digest = hashlib.sha256(data).hexdigest()
     if digest != TFLITE_SHA256:
         raise ModelError(f"{wheel}: {TFLITE_MEMBER} has sha256 {digest}, expected {TFLITE_SHA256}")
@@ -248,8 +250,7 @@ def fetch_model(cache=None, *, wheel=None, force: bool = False) -> Path:
         # Keep the source model too (6 MB): re-conversion needs no download.
         with atomic_path(cached_tflite_path(cache)) as part:
             shutil.copyfile(tflite_path, part)
-    import tflite2onnx
-
+    tflite2onnx = _converter()
     manifest = {
         "model": ONNX_NAME,
         "source": f"mediapipe=={MEDIAPIPE_VERSION} wheel, {TFLITE_MEMBER}",
@@ -265,6 +266,7 @@ def fetch_model(cache=None, *, wheel=None, force: bool = False) -> Path:
 # --------------------------------------------------------------------------
 # tflite2onnx 0.4.1 shared-Pad-constant fix
 # --------------------------------------------------------------------------
+
 
 def _idempotent_pad_transform(original):
     """Wrap ``tflite2onnx.op.padding.Padding.transform`` so it can run twice.
@@ -316,9 +318,21 @@ def patched_tflite2onnx():
         Padding.transform = original
 
 
+def _converter():
+    """The ``tflite2onnx`` module, or a one-line :class:`ModelError` saying how to install it."""
+    try:
+        import tflite2onnx
+    except ImportError:
+        raise ModelError(
+            "converting the pose model needs tflite2onnx: pip install 'capture2notation[models]' "
+            "(or set C2N_POSE_MODEL to an ONNX model you already have)"
+        ) from None
+    return tflite2onnx
+
+
 def convert_tflite(tflite_path, onnx_path) -> Path:
     """Convert a TFLite model to ONNX with tflite2onnx plus the shared-Pad fix."""
-    import tflite2onnx
+    tflite2onnx = _converter()
 
     onnx_path = Path(onnx_path)
     # tflite2onnx logs a warning per float16 weight it folds and per empty

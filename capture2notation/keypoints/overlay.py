@@ -50,7 +50,14 @@ def draw_skeleton(image: np.ndarray, xy: np.ndarray, visibility: np.ndarray, min
     for a, b in POSE_CONNECTIONS:
         if ok[a] and ok[b]:
             colour = _side(b) if _side(a) == _side(b) else _MID
-            cv2.line(out, tuple(np.round(pts[a]).astype(int)), tuple(np.round(pts[b]).astype(int)), colour, scale, cv2.LINE_AA)
+            cv2.line(
+                out,
+                tuple(np.round(pts[a]).astype(int)),
+                tuple(np.round(pts[b]).astype(int)),
+                colour,
+                scale,
+                cv2.LINE_AA,
+            )
     for i in np.flatnonzero(ok):
         filled = -1 if visibility[i] >= min_visibility else scale
         cv2.circle(out, tuple(np.round(pts[i]).astype(int)), 2 * scale, _side(i), filled, cv2.LINE_AA)

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path
 from ..errors import KeypointError
-from ..io.atomic import atomic_path
 
 __all__ = ["LANDMARK_NAMES", "NUM_LANDMARKS", "KeypointTrack", "landmark_index"]
 
@@ -140,7 +140,10 @@ class KeypointTrack:
         arrays = {name: getattr(self, name) for name in _FIELDS}
         arrays["backend"] = np.array(self.backend)
         arrays["names"] = np.array(self.names)
-        with atomic_path(path, suffix=".npz") as tmp, open(tmp, "wb") as f:  # a file object stops numpy appending ".npz"
+        with (
+            atomic_path(path, suffix=".npz") as tmp,
+            open(tmp, "wb") as f,
+        ):  # a file object stops numpy appending ".npz"
             np.savez_compressed(f, **arrays)
         return path
 

@@ -12,16 +12,16 @@ from ..errors import NotationError
 from .model import DIRECTIONS
 
 __all__ = [
-    "SECTOR_DIRECTIONS",
+    "BEND_STEP_DEG",
     "LEVEL_THRESHOLD_DEG",
     "PLACE_THRESHOLD_DEG",
-    "BEND_STEP_DEG",
+    "SECTOR_DIRECTIONS",
     "azimuth_elevation",
-    "classify",
-    "classify_indices",
-    "canonical_vector",
     "bend_angle",
     "bend_degree",
+    "canonical_vector",
+    "classify",
+    "classify_indices",
 ]
 
 #: The eight sector directions in index order (azimuth = 45° × index,

@@ -6,26 +6,27 @@ Time is in beats as exact :class:`fractions.Fraction`; ``seconds = beats ×
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from types import MappingProxyType
-from typing import Iterable
 
 from ..errors import NotationError
+from .effort import EMOTIONS, PRESETS, Effort
 
 __all__ = [
-    "PARTS",
-    "GESTURE_PARTS",
-    "SUPPORT_PARTS",
     "BENDABLE_PARTS",
-    "PART_SEGMENTS",
-    "PART_MIDDLE_JOINT",
     "DIRECTIONS",
-    "LEVELS",
     "EMOTIONS",
+    "GESTURE_PARTS",
+    "LEVELS",
+    "PARTS",
+    "PART_MIDDLE_JOINT",
+    "PART_SEGMENTS",
+    "SUPPORT_PARTS",
     "Effort",
-    "Symbol",
     "Score",
+    "Symbol",
     "as_fraction",
 ]
 
@@ -79,7 +80,6 @@ DIRECTIONS: MappingProxyType = MappingProxyType(
     }
 )
 LEVELS: tuple[str, ...] = ("high", "middle", "low")
-EMOTIONS: tuple[str, ...] = ("happy", "sad", "angry", "afraid")
 MAX_BEND = 6
 
 
@@ -106,33 +106,6 @@ def as_fraction(value, what: str = "value") -> Fraction:
         except (ValueError, ZeroDivisionError):
             raise NotationError(f"{what} {value!r} is not a number or fraction like 3/2") from None
     raise NotationError(f"{what} must be a number or fraction, got {type(value).__name__}")
-
-
-@dataclass(frozen=True)
-class Effort:
-    """Laban Effort of the logistic interpolation (Neagle §5.4–5.5).
-
-    Parameters
-    ----------
-    time : float
-        Gradient b of the logistic, about −2 (sustained) to −4 (sudden);
-        working range [−5, −1.5].
-    weight : float
-        Centroid x0 in (0, 1) where speed peaks: 0.3–0.4 heavy, 0.6–0.8 light.
-    space : float
-        S in [0, 1]: 1 direct, 0 indirect.
-    """
-
-    time: float = -2.0
-    weight: float = 0.5
-    space: float = 1.0
-
-    def __post_init__(self):
-        for name, lo, hi in (("time", -5.0, -1.5), ("weight", 0.05, 0.95), ("space", 0.0, 1.0)):
-            v = getattr(self, name)
-            if not isinstance(v, (int, float)) or not (lo <= v <= hi):
-                raise NotationError(f"effort {name}={v!r} is outside its working range [{lo}, {hi}]")
-            object.__setattr__(self, name, float(v))
 
 
 @dataclass(frozen=True, order=False)
@@ -173,19 +146,12 @@ class Symbol:
         if self.part not in PARTS:
             raise NotationError(f"unknown part {self.part!r}; expected one of {' '.join(PARTS)}")
         if self.direction not in DIRECTIONS:
-            raise NotationError(
-                f"unknown direction {self.direction!r}; expected one of {' '.join(DIRECTIONS)}"
-            )
+            raise NotationError(f"unknown direction {self.direction!r}; expected one of {' '.join(DIRECTIONS)}")
         if self.level not in LEVELS:
             raise NotationError(f"unknown level {self.level!r}; expected one of {' '.join(LEVELS)}")
-        if (
-            self.part in GESTURE_PARTS
-            and self.direction == "place"
-            and self.level == "middle"
-        ):
+        if self.part in GESTURE_PARTS and self.direction == "place" and self.level == "middle":
             raise NotationError(
-                f"{self.part}: 'place middle' has no direction for a gesture; "
-                "use place high, place low or a direction"
+                f"{self.part}: 'place middle' has no direction for a gesture; use place high, place low or a direction"
             )
         if isinstance(self.bend, bool) or not isinstance(self.bend, int) or not 0 <= self.bend <= MAX_BEND:
             raise NotationError(f"bend {self.bend!r} must be an integer 0-{MAX_BEND}")
@@ -279,25 +245,21 @@ class Score:
 
     def resolved_effort(self) -> Effort:
         """The Effort that applies: explicit, else the emotion preset, else neutral."""
-        from ..effort.presets import PRESETS
-
         if self.effort is not None:
             return self.effort
         if self.emotion is not None:
             return PRESETS[self.emotion].effort
         return Effort()
 
-    def with_emotion(self, emotion: str) -> "Score":
+    def with_emotion(self, emotion: str) -> Score:
         """This score performed with an emotion preset: its Effort *and* tempo."""
-        from ..effort.presets import PRESETS
-
         if emotion not in PRESETS:
             raise NotationError(f"unknown emotion {emotion!r}; expected one of {' '.join(EMOTIONS)}")
         return replace(self, emotion=emotion, effort=None, tempo=PRESETS[emotion].tempo)
 
-    def replace(self, **changes) -> "Score":
+    def replace(self, **changes) -> Score:
         return replace(self, **changes)
 
     @classmethod
-    def from_symbols(cls, symbols: Iterable[Symbol], **kw) -> "Score":
+    def from_symbols(cls, symbols: Iterable[Symbol], **kw) -> Score:
         return cls(symbols=tuple(symbols), **kw)

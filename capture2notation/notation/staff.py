@@ -41,7 +41,7 @@ import numpy as np
 from ..errors import NotationError
 from .model import Score, Symbol
 
-__all__ = ["StaffLayout", "Glyph", "staff_layout", "render_staff", "svg_text", "symbol_outline"]
+__all__ = ["Glyph", "StaffLayout", "render_staff", "staff_layout", "svg_text", "symbol_outline"]
 
 _MARGIN_TOP = 70.0
 _MARGIN_BOTTOM = 50.0
@@ -107,11 +107,23 @@ def _columns(score: Score) -> dict:
 
 
 _LABELS = {
-    "right_support": "sup", "left_support": "sup", "right_leg": "leg", "left_leg": "leg",
-    "right_thigh": "thigh", "left_thigh": "thigh", "right_shin": "shin", "left_shin": "shin",
-    "chest": "chest", "_left_body": "body", "right_arm": "arm", "left_arm": "arm",
-    "right_upper_arm": "u.arm", "left_upper_arm": "u.arm", "right_forearm": "f.arm",
-    "left_forearm": "f.arm", "head": "head",
+    "right_support": "sup",
+    "left_support": "sup",
+    "right_leg": "leg",
+    "left_leg": "leg",
+    "right_thigh": "thigh",
+    "left_thigh": "thigh",
+    "right_shin": "shin",
+    "left_shin": "shin",
+    "chest": "chest",
+    "_left_body": "body",
+    "right_arm": "arm",
+    "left_arm": "arm",
+    "right_upper_arm": "u.arm",
+    "left_upper_arm": "u.arm",
+    "right_forearm": "f.arm",
+    "left_forearm": "f.arm",
+    "head": "head",
 }
 
 
@@ -336,8 +348,10 @@ def svg_text(lay: StaffLayout) -> str:
     """SVG document of a layout."""
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{lay.width:.0f}" height="{lay.height:.0f}" '
-        f'viewBox="0 0 {lay.width:.2f} {lay.height:.2f}">',
+        (
+            f'<svg xmlns="http://www.w3.org/2000/svg" width="{lay.width:.0f}" height="{lay.height:.0f}" '
+            f'viewBox="0 0 {lay.width:.2f} {lay.height:.2f}">'
+        ),
         f"<defs>{_hatch_pattern()}</defs>",
         f'<rect width="{lay.width:.2f}" height="{lay.height:.2f}" fill="white"/>',
         '<g class="staff" stroke="black">',
@@ -348,8 +362,7 @@ def svg_text(lay: StaffLayout) -> str:
     parts.append('<g class="labels" font-family="sans-serif">')
     for x, y, text, size, anchor in lay.texts:
         parts.append(
-            f'<text x="{x:.2f}" y="{y:.2f}" font-size="{size}" '
-            f"text-anchor={quoteattr(anchor)}>{_xml_text(text)}</text>"
+            f'<text x="{x:.2f}" y="{y:.2f}" font-size="{size}" text-anchor={quoteattr(anchor)}>{_xml_text(text)}</text>'
         )
     parts.append("</g>")
     parts.append('<g class="symbols">')
@@ -365,7 +378,7 @@ def _render_png(lay: StaffLayout, path, dpi: int) -> None:
     from matplotlib.figure import Figure
     from matplotlib.patches import Circle, Polygon, Rectangle
 
-    from ..io.atomic import atomic_path
+    from ..atomic import atomic_path
 
     # Layout units are pixels at 100 per inch; `dpi` only scales the raster.
     pt = 72.0 / 100.0
@@ -379,16 +392,30 @@ def _render_png(lay: StaffLayout, path, dpi: int) -> None:
     align = {"middle": "center", "end": "right", "start": "left"}
     for x, y, text, size, anchor in lay.texts:
         ax.text(
-            x, y, _XML_INVALID.sub("\ufffd", text), fontsize=size * pt, ha=align[anchor],
-            va="baseline", family="sans-serif", parse_math=False,
+            x,
+            y,
+            _XML_INVALID.sub("\ufffd", text),
+            fontsize=size * pt,
+            ha=align[anchor],
+            va="baseline",
+            family="sans-serif",
+            parse_math=False,
         )
     with matplotlib.rc_context({"hatch.linewidth": 1.2}):
         for g in lay.glyphs:
             s = g.symbol
             face = {"high": "white", "middle": "white", "low": "black"}[s.level]
             for piece in g.pieces:
-                ax.add_patch(Polygon(piece, closed=True, facecolor=face, edgecolor="black",
-                                     lw=1.5 * pt, hatch="////" if s.level == "high" else None))
+                ax.add_patch(
+                    Polygon(
+                        piece,
+                        closed=True,
+                        facecolor=face,
+                        edgecolor="black",
+                        lw=1.5 * pt,
+                        hatch="////" if s.level == "high" else None,
+                    )
+                )
             if s.level == "middle":
                 ax.add_patch(Circle(g.centre, g.dot_radius, color="black"))
             if s.bend:
@@ -433,7 +460,7 @@ def render_staff(
     Path
         The SVG path.
     """
-    from ..io.atomic import write_text
+    from ..atomic import write_text
 
     if not isinstance(score, Score):
         raise NotationError(f"render_staff needs a Score, got {type(score).__name__}")

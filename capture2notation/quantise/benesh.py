@@ -24,21 +24,21 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..atomic import write_text
 from ..body import Body, body_frame, global_rotations, joint_index
 from ..errors import QuantiseError
-from ..io.atomic import write_text
 from ..notation.directions import bend_angle, bend_degree
 
 __all__ = [
-    "STAVE_LINES",
     "DEPTHS",
+    "STAVE_LINES",
+    "BeneshPose",
     "Extremity",
     "Orientation",
-    "BeneshPose",
     "Stave",
-    "estimate_stave",
-    "benesh_key_poses",
     "benesh_json",
+    "benesh_key_poses",
+    "estimate_stave",
     "write_benesh",
 ]
 
@@ -157,7 +157,9 @@ def estimate_stave(joints: np.ndarray, floor: float = 0.0) -> Stave:
     lines = (0.0, z[joint_index("right_knee")], z[joint_index("right_hip")], z[joint_index("right_shoulder")], height)
     reach = []
     for name, (a, m, b) in _EXTREMITIES.items():
-        half = 0.5 * _median_length(joints, a, a.replace("right", "left") if "right" in a else a.replace("left", "right"))
+        half = 0.5 * _median_length(
+            joints, a, a.replace("right", "left") if "right" in a else a.replace("left", "right")
+        )
         reach.append((name, half + _median_length(joints, a, m) + _median_length(joints, m, b)))
     return Stave(lines=tuple(float(v) for v in lines), reach=tuple(reach), floor=float(floor))
 
@@ -247,19 +249,29 @@ def benesh_key_poses(
     for i, f in enumerate(frames):
         R = frame[i]
         ext = []
-        for name, (a, m, b) in _EXTREMITIES.items():
+        for name, (_a, _m, b) in _EXTREMITIES.items():
             p = J[i, joint_index(b)]
             centre = mid_sh[i] if name.endswith("hand") else mid_hip[i]
             reach = stave.reach_of(name)
             rel = R @ (p - centre)
             height = float(_piecewise(np.array([p[2] - stave.floor]), np.r_[lines, 2 * lines[-1] - lines[-2]])[0])
             width = float(rel[0] / reach)
-            depth = "front" if rel[1] > DEPTH_TOLERANCE * reach else "behind" if rel[1] < -DEPTH_TOLERANCE * reach else "level"
+            depth = (
+                "front"
+                if rel[1] > DEPTH_TOLERANCE * reach
+                else "behind"
+                if rel[1] < -DEPTH_TOLERANCE * reach
+                else "level"
+            )
             ext.append((name, Extremity(round(height, 3), round(width, 3), depth)))
         bends = []
         for side in ("right", "left"):
             for mid, (a, b) in (("elbow", ("shoulder", "wrist")), ("knee", ("hip", "ankle"))):
-                beta = bend_angle(J[i, joint_index(f"{side}_{a}")], J[i, joint_index(f"{side}_{mid}")], J[i, joint_index(f"{side}_{b}")])
+                beta = bend_angle(
+                    J[i, joint_index(f"{side}_{a}")],
+                    J[i, joint_index(f"{side}_{mid}")],
+                    J[i, joint_index(f"{side}_{b}")],
+                )
                 k = int(bend_degree(beta))
                 if k >= 0 and k != defaults[mid]:
                     bends.append((f"{side}_{mid}", k))

@@ -17,19 +17,19 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..atomic import write_text
 from ..body import JOINTS, Body, body_frame, joint_index
 from ..errors import QuantiseError
-from ..io.atomic import write_text
 from ..notation.directions import bend_angle, bend_degree, classify_indices
 from ..notation.model import DIRECTIONS, LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, SUPPORT_PARTS
 
 __all__ = [
     "DIRECTION_NAMES",
     "LABEL_PARTS",
-    "SUPPORT_HEIGHT_M",
-    "SUPPORT_SPEED_MS",
     "PLIE_DEG",
     "RELEVE_DEG",
+    "SUPPORT_HEIGHT_M",
+    "SUPPORT_SPEED_MS",
     "FrameLabels",
     "flat_foot_pitch",
     "foot_points",
@@ -172,8 +172,9 @@ def foot_points(joints: np.ndarray) -> tuple[list, list]:
     return low, mid
 
 
-def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0,
-                   flat_pitch=None) -> tuple[np.ndarray, np.ndarray]:
+def support_frames(
+    joints: np.ndarray, fps: float, floor: float = 0.0, flat_pitch=None
+) -> tuple[np.ndarray, np.ndarray]:
     """Which feet support, and at which level, at every frame.
 
     Parameters
@@ -218,9 +219,7 @@ def support_frames(joints: np.ndarray, fps: float, floor: float = 0.0,
         else:
             speed[:] = 0.0
         sup = (low < SUPPORT_HEIGHT_M) & (speed < SUPPORT_SPEED_MS)
-        knee_bend = bend_angle(
-            joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")], ankle
-        )
+        knee_bend = bend_angle(joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")], ankle)
         pitch = _foot_pitch_deg(joints, side)
         lev = np.full(T, MIDDLE)
         lev = np.where(pitch > flat[k] + RELEVE_DEG, LEVELS.index("high"), lev)
@@ -318,8 +317,13 @@ def with_supports(labels: FrameLabels, supporting: np.ndarray, level: np.ndarray
     c = g + SUPPORT_PARTS.index("support")
     direction[:, c] = np.where(both, PLACE, -1)
     lev[:, c] = np.where(both, level[:, 0], -1)
-    return replace(labels, direction=direction, level=lev, supporting=np.asarray(supporting, bool),
-                   support_level=np.where(supporting, level, -1).astype(int))
+    return replace(
+        labels,
+        direction=direction,
+        level=lev,
+        supporting=np.asarray(supporting, bool),
+        support_level=np.where(supporting, level, -1).astype(int),
+    )
 
 
 def labels_csv_text(labels: FrameLabels) -> str:

@@ -15,8 +15,15 @@ import numpy as np
 
 from .labels import FrameLabels
 
-__all__ = ["HYSTERESIS_DEG", "TRUNK_MAX_BIAS_DEG", "TRUNK_MAX_MARGIN_DEG", "held_pose", "hold_frames", "keep_previous",
-           "upright_trunk"]
+__all__ = [
+    "HYSTERESIS_DEG",
+    "TRUNK_MAX_BIAS_DEG",
+    "TRUNK_MAX_MARGIN_DEG",
+    "held_pose",
+    "hold_frames",
+    "keep_previous",
+    "upright_trunk",
+]
 
 #: A part's clip-median direction within this of vertical is taken as a
 #: fit's bias of the upright pose; farther, the dancer holds a real tilt.
@@ -181,8 +188,13 @@ def _toward(v: np.ndarray, c: np.ndarray, deg: float) -> np.ndarray:
     return np.cos(step) * v + np.sin(step) * w
 
 
-def keep_previous(v: np.ndarray, bend: float, label: tuple[str, str, int], previous: tuple[str, str, int],
-                  margin: float = HYSTERESIS_DEG) -> tuple[str, str, int]:
+def keep_previous(
+    v: np.ndarray,
+    bend: float,
+    label: tuple[str, str, int],
+    previous: tuple[str, str, int],
+    margin: float = HYSTERESIS_DEG,
+) -> tuple[str, str, int]:
     """Label of a measured held pose with hysteresis against the part's previous symbol.
 
     The previous direction and level are kept when the pose lies within
@@ -214,9 +226,12 @@ def keep_previous(v: np.ndarray, bend: float, label: tuple[str, str, int], previ
     pd, plv, pk = previous
     if not pd or not np.isfinite(v).all():
         return label
-    if (d, lv) != (pd, plv) and not (pd == "place" and plv == "middle"):
-        if _sector_label(_toward(v, canonical_vector(pd, plv), margin)) == (pd, plv):
-            d, lv = pd, plv
+    if (
+        (d, lv) != (pd, plv)
+        and not (pd == "place" and plv == "middle")
+        and _sector_label(_toward(v, canonical_vector(pd, plv), margin)) == (pd, plv)
+    ):
+        d, lv = pd, plv
     if k != pk and pk >= 0 and np.isfinite(bend) and abs(bend - BEND_STEP_DEG * pk) < BEND_STEP_DEG / 2 + margin:
         k = pk
     return d, lv, k

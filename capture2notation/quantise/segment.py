@@ -51,7 +51,7 @@ Whole limb or segments
     both segments nearer their written directions than the whole limb is to
     its own (``upper_arm`` + ``forearm`` symbols over one span).  A whole-limb
     symbol puts the whole limb exactly on its direction; its segments are
-    almost never both on written directions.  :func:`~.agreement.normalise`
+    almost never both on written directions.  :func:`~capture2notation.compare.agreement.normalise`
     treats an upper + lower pair pointing one way as the straight whole limb.
 
 Supports
@@ -73,17 +73,18 @@ from fractions import Fraction
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..errors import QuantiseError
 from ..body import joint_index
+from ..errors import QuantiseError
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
-from .measured import held_pose, hold_frames, keep_previous, upright_trunk
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
+from .measured import held_pose, hold_frames, keep_previous, upright_trunk
+from .movement import Movement
 from .spans import _ZERO_SPEED, movement_spans
 from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
 from .tempo import estimate_tempo_detail, snap
 from .timing import progress_signal, refine_times
 
-__all__ = ["SegmentParams", "Movement", "Segmentation", "movement_spans", "segment", "segment_motion"]
+__all__ = ["Movement", "SegmentParams", "Segmentation", "movement_spans", "segment", "segment_motion"]
 
 
 @dataclass(frozen=True)
@@ -121,25 +122,6 @@ class SegmentParams:
     min_amplitude_deg: float = 10.0
     split_ratio: float = 0.35
     merge_window_s: float = 0.3
-
-
-@dataclass(frozen=True)
-class Movement:
-    """One detected movement of one part, in frames and seconds.
-
-    ``start_time`` / ``end_time`` are the estimated instants the movement
-    begins and arrives (seconds); ``end_frame`` is the first frame at the
-    arrival pose.
-    """
-
-    part: str
-    start_frame: int
-    end_frame: int
-    start_time: float
-    end_time: float
-    direction: str
-    level: str
-    bend: int = 0
 
 
 @dataclass(frozen=True)
@@ -368,16 +350,28 @@ def segment_motion(
             # Clean key times are within half a frame of their grid time;
             # measured ones (fitted logistic, noisy) within a frame or two.
             tol = (0.3 if clean else 2.0) / fps
-            detail = estimate_tempo_detail(times, params.grid, tolerance_s=tol, durations=gestures or None,
-                                           groups=groups, max_offset_s=0.0 if clean else 3.0 / fps)
+            detail = estimate_tempo_detail(
+                times,
+                params.grid,
+                tolerance_s=tol,
+                durations=gestures or None,
+                groups=groups,
+                max_offset_s=0.0 if clean else 3.0 / fps,
+            )
             tempo = detail.tempo
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
     if tempo <= 0:
         raise QuantiseError(f"tempo must be > 0 beats per minute, got {tempo}")
     # With the beat grid known, clean motion is cut only on its frames;
     # noisy motion never uses the grid, so its first pass stands.
-    noisy = noisy_feet and (measured or params.smooth_s is not None or all(
-        max(_noise_deg(u) for u in _channel(labels, joints, p)[0]) > _CLEAN_NOISE_DEG for p in tuple(_LIMBS) + _SINGLE))
+    noisy = noisy_feet and (
+        measured
+        or params.smooth_s is not None
+        or all(
+            max(_noise_deg(u) for u in _channel(labels, joints, p)[0]) > _CLEAN_NOISE_DEG
+            for p in tuple(_LIMBS) + _SINGLE
+        )
+    )
     if moves is None or not noisy:
         on_grid = _grid_frames(T, fps, tempo, params.grid)
         moves = _gesture_movements(labels, joints, fps, params, on_grid, measured) + support_movements(
@@ -390,8 +384,16 @@ def segment_motion(
     score = Score(symbols=tuple(symbols), title=title, tempo=tempo, meter=meter)
     if detail is None:
         return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels)
-    return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels,
-                        tempo_runner_up=detail.runner_up, tempo_confidence=detail.confidence)
+    return Segmentation(
+        score,
+        tuple(moves),
+        key_frames,
+        tempo,
+        estimated,
+        labels,
+        tempo_runner_up=detail.runner_up,
+        tempo_confidence=detail.confidence,
+    )
 
 
 def _lands_at_end(down: np.ndarray, end_f: int, hold: int) -> bool:
@@ -407,7 +409,9 @@ def _lands_at_end(down: np.ndarray, end_f: int, hold: int) -> bool:
     return bool(down[-1]) and end_f >= len(down) - 1 - hold
 
 
-def segment(joints: np.ndarray, fps: float, tempo=None, meter: int = 4, params: SegmentParams | None = None, floor: float = 0.0) -> Score:
+def segment(
+    joints: np.ndarray, fps: float, tempo=None, meter: int = 4, params: SegmentParams | None = None, floor: float = 0.0
+) -> Score:
     """The score of a motion (see :func:`segment_motion`)."""
     return segment_motion(joints, fps, tempo=tempo, meter=meter, params=params, floor=floor).score
 
@@ -457,8 +461,14 @@ def _off_canonical_series(v: np.ndarray) -> np.ndarray:
     return np.where((d < 0) | ~np.isfinite(out), np.inf, out)
 
 
-def _key_pose_fn(labels: FrameLabels, part: str, on_grid: np.ndarray | None = None, tol: float = 0.05,
-                 min_change: float = 5.0, arrivals: np.ndarray | None = None):
+def _key_pose_fn(
+    labels: FrameLabels,
+    part: str,
+    on_grid: np.ndarray | None = None,
+    tol: float = 0.05,
+    min_change: float = 5.0,
+    arrivals: np.ndarray | None = None,
+):
     """``(f, since) -> bool``: frame f can end a movement.
 
     The part must be exactly where some symbol would put it, f must be a
@@ -559,8 +569,9 @@ def _grid_frames(T: int, fps: float, tempo: Fraction, grid: Fraction) -> np.ndar
     return out
 
 
-def _limb_symbols(labels: FrameLabels, part: str, start_f: int, end_f: int, frames: slice,
-                  params: SegmentParams, clean: bool):
+def _limb_symbols(
+    labels: FrameLabels, part: str, start_f: int, end_f: int, frames: slice, params: SegmentParams, clean: bool
+):
     """Segment symbols for a limb movement, or None when the whole limb is written.
 
     The whole limb is written (with its bend) unless the segments move
@@ -612,12 +623,19 @@ def _has_exact_holds(labels: FrameLabels, joints: np.ndarray, min_intervals: int
     # Supports back to back to the end move the pelvis and legs all the
     # time; then an unnotated part that holds to the last bit while the
     # weight moves (no fit keeps a limb exactly still) shows the motion clean.
-    return bool(np.nanmax(pelvis, initial=0.0) > 0.01 and len(pelvis) >= min_intervals and any(
-        bool(np.all(st < 1e-9)) for st in steps[:-1]))
+    return bool(
+        np.nanmax(pelvis, initial=0.0) > 0.01
+        and len(pelvis) >= min_intervals
+        and any(bool(np.all(st < 1e-9)) for st in steps[:-1])
+    )
 
 
 def _gesture_movements(
-    labels: FrameLabels, joints: np.ndarray, fps: float, params: SegmentParams, on_grid: np.ndarray | None = None,
+    labels: FrameLabels,
+    joints: np.ndarray,
+    fps: float,
+    params: SegmentParams,
+    on_grid: np.ndarray | None = None,
     measured: bool = False,
 ) -> list[Movement]:
     out: list[Movement] = []
@@ -673,8 +691,10 @@ def _gesture_movements(
         for i, (a, b) in enumerate(spans):
             start_f, end_f = a, min(b + 1, T - 1)
             nxt = spans[i + 1][0] if i + 1 < len(spans) else T
-            moved = max([float(_angle_deg(u[start_f], u[end_f])) for u in u_list]
-                        + [abs(float(x[end_f] - x[start_f])) for x in bend_list])
+            moved = max(
+                [float(_angle_deg(u[start_f], u[end_f])) for u in u_list]
+                + [abs(float(x[end_f] - x[start_f])) for x in bend_list]
+            )
             if not moved >= params.min_amplitude_deg:
                 continue
             # The movement leaves frame a's pose and arrives at frame b + 1's.
@@ -701,8 +721,10 @@ def _gesture_movements(
                 # no written pose was carried by the weight transfer (a foot
                 # a step left behind), not a gesture.
                 continue
-            if part in _FOOT and (labels.supporting[end_f, _FOOT[part]]
-                                  or (not clean and _lands_at_end(labels.supporting[:, _FOOT[part]], end_f, hold))):
+            if part in _FOOT and (
+                labels.supporting[end_f, _FOOT[part]]
+                or (not clean and _lands_at_end(labels.supporting[:, _FOOT[part]], end_f, hold))
+            ):
                 # A leg that arrives on the floor is a support, not a gesture.
                 state = ("place", "low", 0)
                 continue
@@ -721,7 +743,9 @@ def _gesture_movements(
                     # Within the fit's own trunk noise of upright.
                     d, lv = _DEFAULT[part]
             if not clean:
-                pose = held_pose(labels.vectors[:, whole], labels.bend_deg[:, whole] if part in _LIMBS else None, frames)
+                pose = held_pose(
+                    labels.vectors[:, whole], labels.bend_deg[:, whole] if part in _LIMBS else None, frames
+                )
                 if _same_pose(pose, last_pose, state, params):
                     # Arrived within the fit's error of the last written pose:
                     # a label change would only be a boundary crossed by it.
@@ -798,7 +822,7 @@ def _fitted_times(u_list: list, x_list: list, spans: list, i: int, fps: float, t
     win = _progress_window(u_list, x_list, spans, i, fps)
     if win is None:
         return t0, t1
-    (f0, f1), = refine_times([win])
+    ((f0, f1),) = refine_times([win])
     return max(f0, 0.0), f1
 
 

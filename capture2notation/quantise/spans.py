@@ -6,6 +6,8 @@ system).  Interval ``i`` of a speed signal spans frames ``i → i + 1``.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 __all__ = ["movement_spans"]
@@ -19,7 +21,12 @@ NEAR_POSE_SPLIT_RATIO = 0.6
 
 
 def movement_spans(
-    speed: np.ndarray, low: float, high: float, split_ratio: float, key_pose=None, near_pose=None,
+    speed: np.ndarray,
+    low: float,
+    high: float,
+    split_ratio: float,
+    key_pose=None,
+    near_pose=None,
     near_ratio: float = NEAR_POSE_SPLIT_RATIO,
 ) -> list[tuple[int, int]]:
     """Movements in a per-interval speed signal.
@@ -118,7 +125,7 @@ def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> 
     bounds = [a] + cuts + [b + 1]
     out = []
     start = None
-    for lo, hi in zip(bounds[:-1], bounds[1:]):
+    for lo, hi in itertools.pairwise(bounds):
         start = lo if start is None else start
         # A slow-starting movement (a sudden Effort) stays on its start pose
         # for a few frames: those pieces belong to the movement that follows.
@@ -130,8 +137,9 @@ def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> 
     return out
 
 
-def _split(s: np.ndarray, a: int, b: int, ratio: float, high: float, near=None,
-           near_ratio: float = 0.0) -> list[tuple[int, int]]:
+def _split(
+    s: np.ndarray, a: int, b: int, ratio: float, high: float, near=None, near_ratio: float = 0.0
+) -> list[tuple[int, int]]:
     """Split interval range [a, b] at its deepest qualifying interior minimum, recursively
     (`near`, `near_ratio`: see :func:`movement_spans`)."""
     if b - a < 2:

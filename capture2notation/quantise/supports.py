@@ -49,9 +49,20 @@ from ..body import joint_index
 from ..notation.directions import bend_angle, classify_indices
 from ..notation.model import LEVELS
 from .labels import DIRECTION_NAMES, FrameLabels, foot_points
+from .movement import Movement
 
-__all__ = ["MIN_GROUNDED", "MIN_PELVIS_M", "MIN_SUPPORT_S", "NOISY_POSITION_M", "STEP_MIN_FRACTION", "position_noise", "smooth_positions", "support_movements",
-           "support_state", "weight_bearing"]
+__all__ = [
+    "MIN_GROUNDED",
+    "MIN_PELVIS_M",
+    "MIN_SUPPORT_S",
+    "NOISY_POSITION_M",
+    "STEP_MIN_FRACTION",
+    "position_noise",
+    "smooth_positions",
+    "support_movements",
+    "support_state",
+    "weight_bearing",
+]
 
 #: A weight-bearing foot that moved farther than this fraction of the body
 #: height from under its hip makes the support a step.
@@ -133,8 +144,10 @@ def _support_speed(labels: FrameLabels, joints: np.ndarray, fps: float) -> np.nd
         # straightening grows like the square root of the leg's shortening,
         # so its speed is unbounded at the start and end of every transfer
         # or rise and would hide the arrivals (and make false minima).
-        reach = np.degrees(np.linalg.norm(
-            joints[:, joint_index(f"{side}_hip")] - joints[:, joint_index(f"{side}_ankle")], axis=-1) / max(float(leg), 1e-6))
+        reach = np.degrees(
+            np.linalg.norm(joints[:, joint_index(f"{side}_hip")] - joints[:, joint_index(f"{side}_ankle")], axis=-1)
+            / max(float(leg), 1e-6)
+        )
         d = joints[:, joint_index(f"{side}_toe")] - joints[:, joint_index(f"{side}_ankle")]
         pitch = np.degrees(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
         c = bearing[:, k]
@@ -166,7 +179,7 @@ def smooth_positions(joints: np.ndarray, fps: float, window_s: float = 0.3) -> n
     joints = np.asarray(joints, dtype=float)
     T = joints.shape[0]
     w = max(5, int(round(window_s * fps)) | 1)
-    if T <= w:
+    if w >= T:
         return joints
     flat = joints.reshape(T, -1)
     bad = ~np.isfinite(flat)
@@ -210,8 +223,15 @@ def _mode_filter(x: np.ndarray, width: int) -> np.ndarray:
     return np.where(keep, x, best)
 
 
-def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, params, spans_fn,
-                      on_grid: np.ndarray | None = None, measured: bool = False) -> list:
+def support_movements(
+    labels: FrameLabels,
+    joints: np.ndarray,
+    fps: float,
+    params,
+    spans_fn,
+    on_grid: np.ndarray | None = None,
+    measured: bool = False,
+) -> list:
     """Support movements as :class:`~.segment.Movement` objects (see the module docstring).
 
     Noisy motion (jitter above :data:`NOISY_POSITION_M`, or `measured`:
@@ -220,7 +240,6 @@ def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, param
     of smoothed joints (:func:`smooth_positions`, as
     :func:`~.segment.segment_motion` does).
     """
-    from .segment import Movement
 
     T = joints.shape[0]
     if measured or position_noise(joints) > NOISY_POSITION_M:
@@ -230,9 +249,20 @@ def support_movements(labels: FrameLabels, joints: np.ndarray, fps: float, param
     # Clean motion: any motion is a movement; back-to-back support
     # symbols part at grid frames with both feet down and the speed at a
     # local minimum (never mid-step, while a foot is in the air).
-    knees = np.stack([bend_angle(joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")],
-                                 joints[:, joint_index(f"{side}_ankle")]) for side in ("right", "left")], axis=1)
-    spans = spans_fn(speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps))
+    knees = np.stack(
+        [
+            bend_angle(
+                joints[:, joint_index(f"{side}_hip")],
+                joints[:, joint_index(f"{side}_knee")],
+                joints[:, joint_index(f"{side}_ankle")],
+            )
+            for side in ("right", "left")
+        ],
+        axis=1,
+    )
+    spans = spans_fn(
+        speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps)
+    )
     height = _body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
     out = []
@@ -304,7 +334,6 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     a change that moves it less than :data:`MIN_PELVIS_M` is contact
     flicker and writes nothing.
     """
-    from .segment import Movement
     from .landing import closing_times
     from .timing import refine_times
 
@@ -317,8 +346,11 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     if grounded < MIN_GROUNDED:
         # Our vocabulary has no jumps: feet found on the floor this rarely
         # mean the floor height is wrong, and the supports would be invented.
-        warnings.warn(f"feet on the floor in only {100 * grounded:.0f} % of {T} frames (expected most of them; "
-                      "is the floor height right?): no support symbols written", stacklevel=3)
+        warnings.warn(
+            f"feet on the floor in only {100 * grounded:.0f} % of {T} frames (expected most of them; "
+            "is the floor height right?): no support symbols written",
+            stacklevel=3,
+        )
         return []
     w = max(3, int(round(0.3 * fps)) | 1)
     code = _mode_filter(_state_code(part, level), w)
@@ -366,7 +398,9 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         # A rise or a sinking on both feet is no step, however the fitted
         # feet slide in its course.
         flew = flew and a not in passed
-        direction = _step_direction(smooth, labels, prev_end, land, new_part, height, offset, since) if flew else "place"
+        direction = (
+            _step_direction(smooth, labels, prev_end, land, new_part, height, offset, since) if flew else "place"
+        )
         for f in feet:
             bore[f] = b
         new = (new_part, new_level, direction)
@@ -383,13 +417,18 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
         if win is None:
             # The pelvis did not move: contact flicker, not a support change.
             continue
-        (t0, t1), = refine_times([win])
+        ((t0, t1),) = refine_times([win])
         if new_part == 0 and state[0] > 0:
             # A closing arrives when the free foot lands: its own travel is
             # sharper (and on time) where the fitted pelvis lags.
             free = 2 - state[0]
-            times = closing_times(smooth[:, joint_index(("right_ankle", "left_ankle")[free])],
-                                  labels.supporting[:, free], min(prev_start, out[-1].start_frame if out else 0), a, fps)
+            times = closing_times(
+                smooth[:, joint_index(("right_ankle", "left_ankle")[free])],
+                labels.supporting[:, free],
+                min(prev_start, out[-1].start_frame if out else 0),
+                a,
+                fps,
+            )
             t0, t1 = times if times is not None else (t0, t1)
         # Nothing arrives after the clip ends (the fitted curve may run past it).
         t1 = min(t1, (T - 1) / fps)
@@ -567,10 +606,14 @@ def _join_flights(moves: list, joints: np.ndarray | None = None) -> list:
     out: list = []
     for m in moves:
         prev = out[-1] if out else None
-        if (prev is not None and m.direction != "place" and prev.direction == "place"
-                and {prev.part, m.part} == {"right_support", "left_support"}
-                and m.start_time - prev.end_time < FLIGHT_GAP_S
-                and not (joints is not None and _pelvis_over_foot(joints, prev))):
+        if (
+            prev is not None
+            and m.direction != "place"
+            and prev.direction == "place"
+            and {prev.part, m.part} == {"right_support", "left_support"}
+            and m.start_time - prev.end_time < FLIGHT_GAP_S
+            and not (joints is not None and _pelvis_over_foot(joints, prev))
+        ):
             out[-1] = replace(m, start_frame=prev.start_frame, start_time=prev.start_time)
             continue
         out.append(m)
@@ -697,8 +740,7 @@ def _pelvis_window(pelvis: np.ndarray, lo: int, a: int, b: int, hi: int, fps: fl
     return np.arange(lo, hi + 1) / fps, prog, 0.5 * (lo + a) / fps, 0.5 * (b + hi) / fps
 
 
-def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None, knees=None,
-                    fps: float = 25.0):
+def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None, knees=None, fps: float = 25.0):
     """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements.
 
     Either a foot lands at f (it supports at f and did not at f - 1), or
@@ -793,8 +835,16 @@ def _plausible_step(joints: np.ndarray, f: int, a: int, k: int, height: float) -
     return float(pelvis @ travel) / dist >= STEP_PELVIS_FOLLOWS * dist
 
 
-def _step_direction(joints, labels: FrameLabels, a: int, k: int, part: int, height: float,
-                    offset: np.ndarray | None = None, starts: dict | None = None) -> str:
+def _step_direction(
+    joints,
+    labels: FrameLabels,
+    a: int,
+    k: int,
+    part: int,
+    height: float,
+    offset: np.ndarray | None = None,
+    starts: dict | None = None,
+) -> str:
     """``place``, or the direction a weight-bearing foot stepped between frames a and k.
 
     `offset` (2, 3): each foot's standing offset from its hip in the

@@ -126,7 +126,7 @@ def estimate_tempo_detail(
     double tempo on the same grid; the estimate may then be 2× (rarely ½×)
     the written tempo — the same movements at the same seconds, every
     start and duration still on the grid (the comparison of
-    :mod:`.agreement` is made in time for this reason).
+    :mod:`capture2notation.compare.agreement` is made in time for this reason).
 
     Parameters
     ----------
@@ -164,9 +164,7 @@ def estimate_tempo_detail(
     t, g = t[keep], g[keep]
     lo, hi = tempo_range
     if t.size < 2:
-        raise QuantiseError(
-            f"cannot estimate a tempo from {t.size} key time(s); give the tempo (--tempo BPM)"
-        )
+        raise QuantiseError(f"cannot estimate a tempo from {t.size} key time(s); give the tempo (--tempo BPM)")
     if not (0 < lo < hi):
         raise QuantiseError(f"tempo range must be 0 < low < high bpm, got {tempo_range}")
     cand = np.arange(np.floor(lo), np.ceil(hi) + 0.25, 0.25)
@@ -242,8 +240,15 @@ _DISTINCT = 0.15
 _WHOLE_BPM_NATS = 4.0
 
 
-def _log_posterior(t: np.ndarray, tempi: np.ndarray, grid: Fraction, tolerance_s: float, durations,
-                   groups=None, max_offset_s: float = 0.0) -> np.ndarray:
+def _log_posterior(
+    t: np.ndarray,
+    tempi: np.ndarray,
+    grid: Fraction,
+    tolerance_s: float,
+    durations,
+    groups=None,
+    max_offset_s: float = 0.0,
+) -> np.ndarray:
     """Log-posterior (C,) of the candidate tempi (see :func:`estimate_tempo`).
 
     Times of groups other than 0 may be offset by a constant of up to

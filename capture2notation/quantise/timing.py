@@ -28,9 +28,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..effort.model import progress, progress_speed
+from ..notation.effort import progress, progress_speed
 
-__all__ = ["B_RANGE", "X0_RANGE", "REFERENCE_EFFORT", "progress_signal", "fit_movement_times", "refine_times"]
+__all__ = ["B_RANGE", "REFERENCE_EFFORT", "X0_RANGE", "fit_movement_times", "progress_signal", "refine_times"]
 
 #: Working ranges of the Effort time b and weight x0 (DESIGN.md, widened a little).
 B_RANGE = (-6.0, -1.2)
@@ -128,11 +128,22 @@ def fit_movement_times(t, p, t0, t1, b=None, x0=None, scale: float | None = None
 
     x_init = np.clip(x_init, np.asarray(lb) + 1e-9, np.asarray(ub) - 1e-9)
     # A tenth of a millisecond is far below a frame: no need to iterate further.
-    res = least_squares(resid, x_init, jac="2-point" if free else jac, bounds=(lb, ub), loss="soft_l1",
-                        f_scale=scale, x_scale="jac", xtol=1e-4 / max(span, 1e-3), ftol=1e-6)
+    res = least_squares(
+        resid,
+        x_init,
+        jac="2-point" if free else jac,
+        bounds=(lb, ub),
+        loss="soft_l1",
+        f_scale=scale,
+        x_scale="jac",
+        xtol=1e-4 / max(span, 1e-3),
+        ftol=1e-6,
+    )
     bb, xx = (float(res.x[2]), float(res.x[3])) if free else (float(b), float(x0))
     rms = float(np.sqrt(np.mean(resid(res.x) ** 2)))
     return float(res.x[0]), float(res.x[1]), bb, xx, rms
+
+
 def refine_times(windows, b: float = REFERENCE_EFFORT[0], x0: float = REFERENCE_EFFORT[1]) -> np.ndarray:
     """Start and arrival times of movements, fitted with one Effort.
 

@@ -9,18 +9,32 @@ __all__ = ["capture"]
 
 @click.command("capture")
 @click.argument("input_path", metavar="INPUT", type=click.Path(exists=True, path_type=str))
-@click.option("-o", "--output", "outdir", required=True, type=click.Path(file_okay=False, path_type=str),
-              help="Folder for score.lab, score.json, laban_editor.json, benesh.json, labels.csv, "
-                   "staff.svg/png, capture.npz, effort.json and index.html.")
-@click.option("--backend", type=click.Choice(["blazepose", "markers"]), default="blazepose", show_default=True,
-              help="Keypoints from a video: the BlazePose model or the renderer's colour markers.")
+@click.option(
+    "-o",
+    "--output",
+    "outdir",
+    required=True,
+    type=click.Path(file_okay=False, path_type=str),
+    help="Folder for score.lab, score.json, laban_editor.json, benesh.json, labels.csv, "
+    "staff.svg/png, capture.npz, effort.json and index.html.",
+)
+@click.option(
+    "--backend",
+    type=click.Choice(["blazepose", "markers"]),
+    default="blazepose",
+    show_default=True,
+    help="Keypoints from a video: the BlazePose model or the renderer's colour markers.",
+)
 @click.option("--tempo", type=float, default=None, help="Beats per minute (default: estimated from the movements).")
 @click.option("--fps-override", type=float, default=None, help="Frame rate to use instead of the input's.")
 @click.option("--grid", default="1/4", show_default=True, help="Beat grid of starts and durations, e.g. 1/4 or 1/2.")
 @click.option("--no-effort", is_flag=True, help="Skip the Laban Effort estimate (the slowest step).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Effort posteriors.")
-@click.option("--flip-test", is_flag=True,
-              help="BlazePose also reads a mirrored copy of each crop (more accurate in side views; slower).")
+@click.option(
+    "--flip-test",
+    is_flag=True,
+    help="BlazePose also reads a mirrored copy of each crop (more accurate in side views; slower).",
+)
 def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
     into notation files in OUTDIR."""
@@ -38,11 +52,23 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
     if step <= 0:
         raise PipelineError(f"--grid {grid!r} must be > 0 beats")
     tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
-    result = run(input_path, outdir, backend=backend, tempo=tempo_value, fps_override=fps_override, progress=True,
-                 params=SegmentParams(grid=step), effort=not no_effort, seed=seed, flip_test=flip_test)
+    result = run(
+        input_path,
+        outdir,
+        backend=backend,
+        tempo=tempo_value,
+        fps_override=fps_override,
+        progress=True,
+        params=SegmentParams(grid=step),
+        effort=not no_effort,
+        seed=seed,
+        flip_test=flip_test,
+    )
     how = tempo_note(result.segmentation, result.kind) if result.segmentation.tempo_estimated else " (given)"
-    click.echo(f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
-               f"({result.kind}), tempo {result.score.tempo} bpm{how}")
+    click.echo(
+        f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
+        f"({result.kind}), tempo {result.score.tempo} bpm{how}"
+    )
     for note in result.skipped:
         click.echo(f"  not written: {note}")
     click.echo(f"  open {result.outdir / 'index.html'}")

@@ -69,10 +69,12 @@ class DemoResult:
 
     def line(self) -> str:
         """One line a person reads in the terminal."""
-        return (f"{self.phrase}: symbol agreement {self.symbol_agreement:.0%} "
-                f"(direction + level per part per beat), median start error {self.median_start_error:.2f} beat, "
-                f"tempo {self.tempo[1]:g} bpm captured vs {self.tempo[0]:g} written, "
-                f"limb directions {self.limb_error_deg:.1f}° off (median), MPJPE {self.mpjpe_mm:.0f} mm")
+        return (
+            f"{self.phrase}: symbol agreement {self.symbol_agreement:.0%} "
+            f"(direction + level per part per beat), median start error {self.median_start_error:.2f} beat, "
+            f"tempo {self.tempo[1]:g} bpm captured vs {self.tempo[0]:g} written, "
+            f"limb directions {self.limb_error_deg:.1f}° off (median), MPJPE {self.mpjpe_mm:.0f} mm"
+        )
 
 
 def _limb_error(truth_joints: np.ndarray, fitted_joints: np.ndarray) -> float:
@@ -85,17 +87,17 @@ def _limb_error(truth_joints: np.ndarray, fitted_joints: np.ndarray) -> float:
     return float(np.nanmedian(err)) if np.isfinite(err).any() else float("nan")
 
 
-def run_phrase(name: str, score, folder: Path, *, fps: float, size, view: str, style: str,
-               effort: bool, progress: bool) -> DemoResult:
+def run_phrase(
+    name: str, score, folder: Path, *, fps: float, size, view: str, style: str, effort: bool, progress: bool
+) -> DemoResult:
     """Render `score`, capture the video, compare with the original; see :class:`DemoResult`."""
+    from capture2notation.compare.agreement import agreement_cells, compare_scores
     from capture2notation.io.truth import read_truth
-    from capture2notation.quantise.agreement import agreement_cells, compare_scores
     from pipelines.capture import capture
     from pipelines.score import run_score
     from synthetic.render import render_score
 
-    render_dir = render_score(score, folder / "render", fps=fps, size=size, view=view, style=style,
-                              progress=progress)
+    render_dir = render_score(score, folder / "render", fps=fps, size=size, view=view, style=style, progress=progress)
     cap = capture(render_dir / "video.mp4", folder / "capture", progress=progress, effort=effort)
     agreement = compare_scores(score, cap.score)
     truth = read_truth(render_dir / "truth.npz")
@@ -110,14 +112,25 @@ def run_phrase(name: str, score, folder: Path, *, fps: float, size, view: str, s
         limb_error_deg=_limb_error(np.asarray(truth.joints), np.asarray(cap.motion.joints)),
         mpjpe_mm=float(summary["mpjpe_mm"]),
         seconds=dict(cap.seconds),
-        differences=tuple((c.part, float(c.beat) - 0.5, " ".join(c.ref), " ".join(c.cand))
-                          for c in agreement_cells(score, cap.score) if c.ref != c.cand),
+        differences=tuple(
+            (c.part, float(c.beat) - 0.5, " ".join(c.ref), " ".join(c.cand))
+            for c in agreement_cells(score, cap.score)
+            if c.ref != c.cand
+        ),
     )
 
 
-def run_demo(outdir="c2n-demo", *, phrases=("port_de_bras",), fps: float = 25.0, size=(640, 480),
-             view: str = "front", style: str = "mannequin", effort: bool = True,
-             progress: bool = True) -> list[DemoResult]:
+def run_demo(
+    outdir="c2n-demo",
+    *,
+    phrases=("port_de_bras",),
+    fps: float = 25.0,
+    size=(640, 480),
+    view: str = "front",
+    style: str = "mannequin",
+    effort: bool = True,
+    progress: bool = True,
+) -> list[DemoResult]:
     """Run the loop render → capture → notation → comparison on built-in phrases.
 
     Parameters
@@ -137,8 +150,8 @@ def run_demo(outdir="c2n-demo", *, phrases=("port_de_bras",), fps: float = 25.0,
     -------
     list of DemoResult
     """
+    from capture2notation.atomic import write_text
     from capture2notation.errors import PipelineError
-    from capture2notation.io.atomic import write_text
     from synthetic.phrases import builtin_phrases
 
     available = builtin_phrases()
@@ -146,8 +159,20 @@ def run_demo(outdir="c2n-demo", *, phrases=("port_de_bras",), fps: float = 25.0,
     if missing:
         raise PipelineError(f"unknown built-in phrase(s) {', '.join(missing)}; available: {', '.join(available)}")
     outdir = Path(outdir)
-    results = [run_phrase(name, available[name], outdir / name, fps=fps, size=size, view=view, style=style,
-                          effort=effort, progress=progress) for name in phrases]
+    results = [
+        run_phrase(
+            name,
+            available[name],
+            outdir / name,
+            fps=fps,
+            size=size,
+            view=view,
+            style=style,
+            effort=effort,
+            progress=progress,
+        )
+        for name in phrases
+    ]
     write_text(outdir / "index.html", index_html(results))
     return results
 
@@ -188,17 +213,34 @@ def _differences_html(r: DemoResult) -> str:
     name = html.escape(r.phrase)
     if not r.differences:
         return f"<h2>{name}</h2><p>The captured score agrees with the original on every beat.</p>\n"
-    rows = "".join(f"<tr><td>{html.escape(part)}</td><td>{beat:g}</td><td>{html.escape(w)}</td><td>{html.escape(c)}</td></tr>"
-                   for part, beat, w, c in r.differences)
-    return (f"<h2>{name}: where the capture differs</h2>\n<table><tr><th>part</th><th>beat</th>"
-            f"<th>written</th><th>captured</th></tr>{rows}</table>\n")
+    rows = "".join(
+        f"<tr><td>{html.escape(part)}</td><td>{beat:g}</td><td>{html.escape(w)}</td><td>{html.escape(c)}</td></tr>"
+        for part, beat, w, c in r.differences
+    )
+    return (
+        f"<h2>{name}: where the capture differs</h2>\n<table><tr><th>part</th><th>beat</th>"
+        f"<th>written</th><th>captured</th></tr>{rows}</table>\n"
+    )
 
 
 @click.command("demo")
-@click.option("-o", "--output", "outdir", default="c2n-demo", show_default=True,
-              type=click.Path(file_okay=False, path_type=str), help="Folder for the demo outputs.")
-@click.option("--phrase", "phrases", multiple=True, default=("port_de_bras",), show_default=True,
-              help=f"Built-in phrase to run ({', '.join(DEMO_PHRASES)} or all); repeatable.")
+@click.option(
+    "-o",
+    "--output",
+    "outdir",
+    default="c2n-demo",
+    show_default=True,
+    type=click.Path(file_okay=False, path_type=str),
+    help="Folder for the demo outputs.",
+)
+@click.option(
+    "--phrase",
+    "phrases",
+    multiple=True,
+    default=("port_de_bras",),
+    show_default=True,
+    help=f"Built-in phrase to run ({', '.join(DEMO_PHRASES)} or all); repeatable.",
+)
 @click.option("--size", default="640x480", show_default=True, help="Image WIDTHxHEIGHT in pixels.")
 @click.option("--view", default="front", show_default=True, help="Camera: front, 45 or side.")
 @click.option("--style", default="mannequin", show_default=True, help="Drawing: mannequin, stick or markers.")

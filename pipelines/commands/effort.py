@@ -80,8 +80,14 @@ def run_effort(capture_dir, seed: int = 0, workers: int = 2, plots: bool = True)
         raise PipelineError(f"{score_path}: score not found (the movements' timing comes from it)")
     score = read(score_path)
     result = estimate_effort(
-        cap["joints"], cap["confidence"], cap["fps"], score, rng=np.random.default_rng(seed),
-        times=cap["times"], joint_names=cap["joint_names"], workers=workers,
+        cap["joints"],
+        cap["confidence"],
+        cap["fps"],
+        score,
+        rng=np.random.default_rng(seed),
+        times=cap["times"],
+        joint_names=cap["joint_names"],
+        workers=workers,
     )
     paths = write_effort(result, capture_dir, plots=plots, rng=seed)
     return result, paths
@@ -96,8 +102,9 @@ def effort(capture_dir, seed, workers, no_plots):
     """Recompute effort.json (and plots) from CAPTURE_DIR/capture.npz and score.lab."""
     result, paths = run_effort(capture_dir, seed=seed, workers=workers, plots=not no_plots)
     n_conv = sum(m.posterior.converged for m in result.movements)
-    click.echo(f"{paths['json']}: {len(result.movements)} movements ({n_conv} converged), "
-               f"{len(result.skipped)} skipped")
+    click.echo(
+        f"{paths['json']}: {len(result.movements)} movements ({n_conv} converged), {len(result.skipped)} skipped"
+    )
     if result.emotion:
         best = max(result.emotion, key=result.emotion.get)
         click.echo("emotion: " + ", ".join(f"{k} {v:.2f}" for k, v in result.emotion.items()) + f" -> {best}")

@@ -10,11 +10,20 @@ __all__ = ["fidelity_study"]
 
 
 @click.command("fidelity-study")
-@click.option("--config", "config_path", type=click.Path(exists=True, dir_okay=False), default=None,
-              help="study.toml (defaults: every built-in phrase, four emotions, all factors).")
+@click.option(
+    "--config",
+    "config_path",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="study.toml (defaults: every built-in phrase, four emotions, all factors).",
+)
 @click.option("--quick", is_flag=True, help="A tiny grid that finishes in a few minutes on 2 cores.")
-@click.option("--scheduler", default=None, metavar="ADDRESS",
-              help="Run the jobs on a Dask distributed cluster (e.g. tcp://host:8786) instead of local cores.")
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Run the jobs on a Dask distributed cluster (e.g. tcp://host:8786) instead of local cores.",
+)
 @click.option("--workers", type=int, default=None, help="Local worker processes (default: number of cores).")
 @click.option("--seed", type=int, default=None, help="Override the config's seed.")
 @click.option("-o", "--outdir", required=True, type=click.Path(file_okay=False), help="Output folder (resumable).")
@@ -32,8 +41,10 @@ def fidelity_study(config_path, quick, scheduler, workers, seed, outdir):
     result = run_fidelity_study(cfg, outdir, is_quick=quick, scheduler=scheduler, workers=workers)
     s = result.summary
     base = next((e for e in s.get("experiment1", []) if e["factor"] == "baseline"), None)
-    click.echo(f"{s['jobs']['total']} jobs ({s['jobs']['cached']} cached, {s['jobs']['failed']} failed) "
-               f"in {time.perf_counter() - t0:.0f} s; capture path: {s['capture']}")
+    click.echo(
+        f"{s['jobs']['total']} jobs ({s['jobs']['cached']} cached, {s['jobs']['failed']} failed) "
+        f"in {time.perf_counter() - t0:.0f} s; capture path: {s['capture']}"
+    )
     if base:
         click.echo(f"observer at baseline: {base['percent_correct']:.1f} % correct (experts 78.70 %)")
     click.echo(f"report: {outdir}/report.html")

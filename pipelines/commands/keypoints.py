@@ -11,15 +11,34 @@ from capture2notation.keypoints import BACKENDS, extract
 @click.argument("video", type=click.Path(exists=True, path_type=str))
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Track file to write (.npz).")
 @click.option("--backend", type=click.Choice(BACKENDS), default="blazepose", show_default=True)
-@click.option("--overlay", type=click.Path(dir_okay=False), default=None, help="Also write the video with the skeleton drawn (.mp4/.avi).")
-@click.option("--model", type=click.Path(exists=True, dir_okay=False), default=None, help="ONNX pose model (default: $C2N_POSE_MODEL or the cache).")
+@click.option(
+    "--overlay",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Also write the video with the skeleton drawn (.mp4/.avi).",
+)
+@click.option(
+    "--model",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="ONNX pose model (default: $C2N_POSE_MODEL or the cache).",
+)
 @click.option("--fps", type=float, default=None, help="Frame rate of an image folder (default 30).")
 @click.option("--threads", type=int, default=2, show_default=True, help="onnxruntime threads.")
 @click.option("--no-smooth", is_flag=True, help="Disable the one-euro temporal filter.")
-@click.option("--markers", "markers_file", type=click.Path(exists=True, dir_okay=False), default=None, help="JSON marker colours for --backend markers (default: the renderer's).")
-@click.option("--flip-test", is_flag=True,
-              help="Also read a mirrored copy of each crop and keep the reading facing the right way "
-                   "(more accurate in side views and folded arms; about half the speed).")
+@click.option(
+    "--markers",
+    "markers_file",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help="JSON marker colours for --backend markers (default: the renderer's).",
+)
+@click.option(
+    "--flip-test",
+    is_flag=True,
+    help="Also read a mirrored copy of each crop and keep the reading facing the right way "
+    "(more accurate in side views and folded arms; about half the speed).",
+)
 def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, markers_file, flip_test):
     """Extract 33 BlazePose keypoints per frame from VIDEO (file or image folder)."""
     markers = None
@@ -28,7 +47,14 @@ def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, m
 
         markers = read_marker_specs(markers_file)
     track = extract(
-        video, backend, model=model, fps=fps, threads=threads, smooth=not no_smooth, markers=markers, progress=True,
+        video,
+        backend,
+        model=model,
+        fps=fps,
+        threads=threads,
+        smooth=not no_smooth,
+        markers=markers,
+        progress=True,
         flip_test=flip_test,
     )
     track.save(output)

@@ -13,7 +13,12 @@ def models():
 
 
 @models.command("fetch")
-@click.option("--wheel", type=click.Path(exists=True, dir_okay=False), default=None, help=f"Use this mediapipe-{pose_model.MEDIAPIPE_VERSION} wheel instead of downloading it.")
+@click.option(
+    "--wheel",
+    type=click.Path(exists=True, dir_okay=False),
+    default=None,
+    help=f"Use this mediapipe-{pose_model.MEDIAPIPE_VERSION} wheel instead of downloading it.",
+)
 @click.option("--force", is_flag=True, help="Rebuild even if a valid cached model exists.")
 def fetch(wheel, force):
     """Download mediapipe's BlazePose model with pip, convert it to ONNX, verify and cache it."""

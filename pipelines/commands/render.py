@@ -39,8 +39,14 @@ def _fps(value: float) -> float:
 
 @click.command("render")
 @click.argument("score", type=click.Path(dir_okay=False, path_type=str))
-@click.option("-o", "--output", "outdir", required=True, type=click.Path(file_okay=False, path_type=str),
-              help="Folder to write video.mp4, truth.npz and score.lab into.")
+@click.option(
+    "-o",
+    "--output",
+    "outdir",
+    required=True,
+    type=click.Path(file_okay=False, path_type=str),
+    help="Folder to write video.mp4, truth.npz and score.lab into.",
+)
 @click.option("--fps", type=float, default=25.0, show_default=True, help="Frames per second.")
 @click.option("--size", default="640x480", show_default=True, help="Image WIDTHxHEIGHT in pixels.")
 @click.option("--view", default="front", show_default=True, help="Camera: front, 45 or side.")
@@ -61,6 +67,9 @@ def render(score, outdir, fps, size, view, style, emotion, png):
     check_choice(emotion, "--emotion", list(EMOTIONS))
     parsed = read(score)
     video = "frames" if png else "video.mp4"
-    out = render_score(parsed, outdir, fps=fps, size=wh, view=view, style=style, emotion=emotion, progress=True,
-                       video_name=video)
-    click.echo(f"{out}: {video}, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps)")
+    out = render_score(
+        parsed, outdir, fps=fps, size=wh, view=view, style=style, emotion=emotion, progress=True, video_name=video
+    )
+    click.echo(
+        f"{out}: {video}, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps)"
+    )

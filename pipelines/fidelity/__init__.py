@@ -11,21 +11,27 @@ from __future__ import annotations
 from .config import StudyConfig, load_config, quick
 from .runner import STUDY_VERSION, run_condition, run_study
 
-__all__ = ["StudyConfig", "load_config", "quick", "run_condition", "run_study", "run_fidelity_study", "STUDY_VERSION"]
+__all__ = ["STUDY_VERSION", "StudyConfig", "load_config", "quick", "run_condition", "run_fidelity_study", "run_study"]
 
 CAPTURE_NOTES = {
     "truth": "truth path — the virtual dancer's joints projected into each camera, jittered and rounded to pixels, "
-             "lifted back with the true depth (no image, no pose detector, no fitting; compression not modelled)",
+    "lifted back with the true depth (no image, no pose detector, no fitting; compression not modelled)",
     "keypoints": "keypoint path — the dancer's 33 BlazePose landmarks projected into each camera with self-occlusion, "
-                 "jittered and rounded to pixels, then fitted in 3D by capture2notation.fitting (no image and no "
-                 "pose detector; compression not modelled)",
+    "jittered and rounded to pixels, then fitted in 3D by capture2notation.fitting (no image and no "
+    "pose detector; compression not modelled)",
     "video": "video path — the renderer draws each take, the kept frames are held in between, JPEG-compressed and "
-             "noised, and c2n capture (BlazePose, fitting, segmentation) reads the video",
+    "noised, and c2n capture (BlazePose, fitting, segmentation) reads the video",
 }
 
 
-def run_fidelity_study(cfg: StudyConfig, outdir, is_quick: bool = False, scheduler: str | None = None,
-                       workers: int | None = None, progress: bool = True):
+def run_fidelity_study(
+    cfg: StudyConfig,
+    outdir,
+    is_quick: bool = False,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool = True,
+):
     """Run a study end to end and write its report; return the :class:`~.runner.StudyResult`."""
     from .measure import builtin_scores
     from .report import write_report

@@ -25,15 +25,15 @@ from capture2notation.notation.model import Effort
 from .config import StudyConfig
 
 __all__ = [
-    "Condition",
-    "Performance",
-    "Job",
     "VARIATION",
+    "Condition",
+    "Job",
+    "Performance",
     "build_conditions",
     "build_jobs",
+    "phrase_complexity",
     "stable_seed",
     "take_variation",
-    "phrase_complexity",
 ]
 
 #: Take-to-take variation of a performance (standard deviations), our stated
@@ -128,7 +128,7 @@ class Job:
 def stable_seed(*parts) -> list[int]:
     """Seed sequence entropy from strings/ints, independent of Python's hash salt."""
     h = hashlib.sha256("\x1f".join(str(p) for p in parts).encode()).digest()
-    return [int.from_bytes(h[i:i + 4], "little") for i in range(0, 16, 4)]
+    return [int.from_bytes(h[i : i + 4], "little") for i in range(0, 16, 4)]
 
 
 def _rate_str(r, source) -> str:
@@ -152,8 +152,14 @@ def build_conditions(cfg: StudyConfig) -> list[Condition]:
             method = "keyframe"
         w, h = size if size is not None else b["image_size"]
         return Condition(
-            factor, rs, method, int(w), int(h), b["view"] if view is None else view,
-            int(b["compression"] if comp is None else comp), float(b["noise"] if noise is None else noise),
+            factor,
+            rs,
+            method,
+            int(w),
+            int(h),
+            b["view"] if view is None else view,
+            int(b["compression"] if comp is None else comp),
+            float(b["noise"] if noise is None else noise),
         )
 
     out = [make("baseline")]

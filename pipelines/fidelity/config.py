@@ -27,9 +27,10 @@ take).  Example ``study.toml``::
 from __future__ import annotations
 
 import dataclasses
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+import tomllib
 
 from capture2notation.compare.resample import as_rate
 from capture2notation.errors import PipelineError
@@ -91,9 +92,15 @@ class StudyConfig:
     views: tuple = VIEWS
     compression: tuple = (0, 60, 20)
     noise: tuple = (0.0, 2.0, 5.0)
-    baseline: dict = field(default_factory=lambda: {
-        "frame_rate": 25.0, "image_size": (640, 480), "view": "front", "compression": 0, "noise": 0.0,
-    })
+    baseline: dict = field(
+        default_factory=lambda: {
+            "frame_rate": 25.0,
+            "image_size": (640, 480),
+            "view": "front",
+            "compression": 0,
+            "noise": 0.0,
+        }
+    )
     source_fps: float = 25.0
     bootstrap: int = 30
 
@@ -107,7 +114,9 @@ class StudyConfig:
         if len(self.emotions) < 2:
             raise PipelineError(f"{where}: same/different trials need at least 2 emotions, got {list(self.emotions)}")
         if self.takes < 2 or self.training_takes < 2:
-            raise PipelineError(f"{where}: takes and training_takes must be >= 2, got {self.takes}, {self.training_takes}")
+            raise PipelineError(
+                f"{where}: takes and training_takes must be >= 2, got {self.takes}, {self.training_takes}"
+            )
         if self.capture not in CAPTURES:
             raise PipelineError(f"{where}: capture {self.capture!r} must be one of {', '.join(CAPTURES)}")
         for m in self.resampling:
@@ -172,7 +181,9 @@ def load_config(path=None, overrides: dict | None = None) -> StudyConfig:
     unknown = sorted(set(data) - known)
     if unknown:
         where = str(path) if path is not None else "study config"
-        raise PipelineError(f"{where}: unknown setting(s) {', '.join(unknown)}; expected some of {', '.join(sorted(known))}")
+        raise PipelineError(
+            f"{where}: unknown setting(s) {', '.join(unknown)}; expected some of {', '.join(sorted(known))}"
+        )
     kw = {}
     for k, v in data.items():
         if k == "baseline":
@@ -191,6 +202,7 @@ def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:
     the extreme levels of each factor; the capture path is the config's
     (``auto``: the keypoint path with 3D fitting, about a minute on 2 cores).
     """
+
     def ends(seq):
         seq = tuple(seq)
         return seq if len(seq) <= 2 else (seq[0], seq[-1])

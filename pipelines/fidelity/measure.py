@@ -45,7 +45,15 @@ from capture2notation.notation.model import PART_SEGMENTS, Score
 
 from .conditions import Condition, Performance, take_variation
 
-__all__ = ["DETECTOR_FLOOR_PX", "perform", "kept_frames", "capture", "interpolate_missing", "measure", "estimate_effort"]
+__all__ = [
+    "DETECTOR_FLOOR_PX",
+    "capture",
+    "estimate_effort",
+    "interpolate_missing",
+    "kept_frames",
+    "measure",
+    "perform",
+]
 
 log = logging.getLogger(__name__)
 
@@ -192,8 +200,15 @@ def _capture_video(score: Score, motion, kept, cond: Condition, rng):
     T = motion.n_frames
     with tempfile.TemporaryDirectory(prefix="c2n-fidelity-") as tmp:
         tmp = Path(tmp)
-        render_score(score, tmp / "render", fps=motion.fps, size=(cond.width, cond.height), view=cond.view,
-                     progress=False, body=motion.body)
+        render_score(
+            score,
+            tmp / "render",
+            fps=motion.fps,
+            size=(cond.width, cond.height),
+            view=cond.view,
+            progress=False,
+            body=motion.body,
+        )
         frames = [f.image for f in iter_frames(tmp / "render" / "video.mp4")]
         if not frames:
             raise PipelineError("the renderer wrote an empty video")
@@ -202,13 +217,19 @@ def _capture_video(score: Score, motion, kept, cond: Condition, rng):
             for i in range(T):
                 img = frames[min(shown[i], len(frames) - 1)]
                 if cond.compression:
-                    ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
+                    _ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
                     img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
                 if cond.noise:
                     img = np.clip(img + rng.normal(0.0, cond.noise, img.shape), 0, 255).astype(np.uint8)
                 w.write(img)
-        run_capture(tmp / "degraded.mp4", tmp / "capture", effort=False, overlay=False, progress=False,
-                    seed=int(rng.integers(2**31)))
+        run_capture(
+            tmp / "degraded.mp4",
+            tmp / "capture",
+            effort=False,
+            overlay=False,
+            progress=False,
+            seed=int(rng.integers(2**31)),
+        )
         with np.load(tmp / "capture" / "capture.npz") as z:
             joints = np.asarray(z["joints"], float)
             conf = np.asarray(z["confidence"], float) if "confidence" in z.files else np.isfinite(joints[..., 0]) * 1.0
@@ -270,7 +291,9 @@ def estimate_effort(joints, confidence, fps: float, score: Score, kept: np.ndarr
         if s.part not in PART_SEGMENTS:
             continue
         try:
-            c = progress_curve(joints[kept], confidence[kept], times, s.part, score.seconds(s.start), score.seconds(s.end))
+            c = progress_curve(
+                joints[kept], confidence[kept], times, s.part, score.seconds(s.start), score.seconds(s.end)
+            )
         except C2NError:
             continue  # too few frames inside this movement at this frame rate
         if c is not None:
@@ -296,9 +319,12 @@ def estimate_effort(joints, confidence, fps: float, score: Score, kept: np.ndarr
         tau, s, w = pooled(sel)
         # One warm start from the full fit: resamples stay near it, and the
         # multi-start search of fit_logistic would cost 4x as much.
+        sw = np.sqrt(w)
         r = optimize.least_squares(
-            lambda p, tau=tau, s=s, sw=np.sqrt(w): sw * (progress(tau, p[0], p[1]) - s), [lf.b, lf.x0],
-            bounds=([TIME_RANGE[0], WEIGHT_RANGE[0]], [TIME_RANGE[1], WEIGHT_RANGE[1]]), x_scale=[1.0, 0.1],
+            lambda p, tau=tau, s=s, sw=sw: sw * (progress(tau, p[0], p[1]) - s),
+            [lf.b, lf.x0],
+            bounds=([TIME_RANGE[0], WEIGHT_RANGE[0]], [TIME_RANGE[1], WEIGHT_RANGE[1]]),
+            x_scale=[1.0, 0.1],
         )
         boots.append((r.x[0], r.x[1], space(sel)))
     boots = np.array(boots, dtype=float).reshape(-1, 3)

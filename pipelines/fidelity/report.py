@@ -21,7 +21,7 @@ from pipelines.report_html import Report
 
 from .measure import DETECTOR_FLOOR_PX
 
-__all__ = ["write_report", "condition_table", "conclusions"]
+__all__ = ["conclusions", "condition_table", "write_report"]
 
 METRICS = (
     ("symbol_accuracy", "symbol accuracy at key poses", 1.0),
@@ -57,7 +57,9 @@ def condition_table(rows: list[dict], conditions, summary: dict) -> list[dict]:
     groups = defaultdict(list)
     for r in rows:
         if r["split"] == "test":
-            groups[(r["frame_rate"], r["resampling"], r["width"], r["height"], r["view"], r["compression"], r["noise"])].append(r)
+            groups[
+                (r["frame_rate"], r["resampling"], r["width"], r["height"], r["view"], r["compression"], r["noise"])
+            ].append(r)
     out = []
     for c in conditions:
         g = groups.get(c.params(), [])
@@ -69,7 +71,9 @@ def condition_table(rows: list[dict], conditions, summary: dict) -> list[dict]:
         line["timing_error_s"] = _mean(r.get("timing_error_s") for r in ok)
         line["mpjpe_mm"] = _mean(r.get("mpjpe_mm") for r in ok)
         for n in ("time", "weight", "space"):
-            line[f"{n}_abs_error"] = _mean(abs(r[f"{n}_error"]) if r.get(f"{n}_error") is not None else None for r in ok)
+            line[f"{n}_abs_error"] = _mean(
+                abs(r[f"{n}_error"]) if r.get(f"{n}_error") is not None else None for r in ok
+            )
         line["coverage"] = _mean([r.get(f"{n}_covered") for r in ok for n in ("time", "weight", "space")])
         line["percent_correct"] = pct.get(c.label, float("nan"))
         line["trials"] = trials.get(c.label, 0)
@@ -91,10 +95,12 @@ def conclusions(table: list[dict], summary: dict) -> list[str]:
     if base is None:
         return ["No baseline condition was measured."]
     lines = [
-        f"Baseline ({base['condition']}): symbol accuracy {base['symbol_accuracy']:.0%}, limb angle error "
-        f"{base['angle_error_deg']:.1f}°, timing error {base['timing_error_s']:.3f} s; the automated observer "
-        f"judged {base['percent_correct']:.1f} % of same/different trials correctly "
-        f"(the thesis' experts: {THESIS['experiment1_overall']:.2f} %)."
+        (
+            f"Baseline ({base['condition']}): symbol accuracy {base['symbol_accuracy']:.0%}, limb angle error "
+            f"{base['angle_error_deg']:.1f}°, timing error {base['timing_error_s']:.3f} s; the automated observer "
+            f"judged {base['percent_correct']:.1f} % of same/different trials correctly "
+            f"(the thesis' experts: {THESIS['experiment1_overall']:.2f} %)."
+        )
     ]
 
     def ok(t):
@@ -106,8 +112,13 @@ def conclusions(table: list[dict], summary: dict) -> list[str]:
             good = good and p >= 0.05
         return good
 
-    names = {"frame_rate": "frame rate", "image_size": "image size", "view": "viewpoint",
-             "compression": "compression", "noise": "pixel noise"}
+    names = {
+        "frame_rate": "frame rate",
+        "image_size": "image size",
+        "view": "viewpoint",
+        "compression": "compression",
+        "noise": "pixel noise",
+    }
     for factor, name in names.items():
         levels = [t for t in table if t["factor"] == factor]
         if not levels:
@@ -120,8 +131,11 @@ def conclusions(table: list[dict], summary: dict) -> list[str]:
             lines.append(f"{name.capitalize()}: not measured ({levels[0]['jobs']} jobs failed).")
             continue
         good = [_level(t, factor) for t in measured if ok(t)]
-        bad = [f"{_level(t, factor)} (symbols {t['symbol_accuracy']:.0%}, observer {t['percent_correct']:.0f} %)"
-               for t in measured if not ok(t)]
+        bad = [
+            f"{_level(t, factor)} (symbols {t['symbol_accuracy']:.0%}, observer {t['percent_correct']:.0f} %)"
+            for t in measured
+            if not ok(t)
+        ]
         s = f"{name.capitalize()}: sufficient — {', '.join(good) if good else 'none of the levels tried'}."
         if bad:
             s += f" Not sufficient — {'; '.join(bad)}."
@@ -161,8 +175,10 @@ def _figures(rep: Report, result, table) -> None:
         comps = [c for c in ("easy", "medium", "hard") if any(t["complexity"] == c for t in trials)]
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         for k, (kind, col) in enumerate((("same", "#4a78b0"), ("different", "#7fb04a"))):
-            vals = [100 * _mean([t["correct"] for t in trials if t["complexity"] == c and t["same"] == (kind == "same")])
-                    for c in comps]
+            vals = [
+                100 * _mean([t["correct"] for t in trials if t["complexity"] == c and t["same"] == (kind == "same")])
+                for c in comps
+            ]
             ax.bar(np.arange(len(comps)) + (k - 0.5) * 0.38, vals, width=0.38, label=f"{kind} pairs", color=col)
         ax.axhline(THESIS["experiment1_overall"], color="#b03a2e", ls="--", lw=1, label="experts overall (78.70 %)")
         ax.set_xticks(range(len(comps)), comps)
@@ -170,23 +186,48 @@ def _figures(rep: Report, result, table) -> None:
         ax.set_ylabel("% correct")
         ax.set_title("By complexity (cf. Neagle Fig. 3.13)", fontsize=10)
         ax.legend(fontsize=7, loc="lower right")
-        rep.figure(fig, "fig313_complexity", "Percentage of same/different trials judged correctly at each level of "
-                   "complexity, baseline condition (Experiment 1 design).")
+        rep.figure(
+            fig,
+            "fig313_complexity",
+            "Percentage of same/different trials judged correctly at each level of "
+            "complexity, baseline condition (Experiment 1 design).",
+        )
         # Figure 3.14: same pairs per emotion.
-        same = sorted({t["pair"] for t in trials if t["same"]}, key=lambda p: ("happy", "sad", "angry", "afraid").index(p.split("-")[0]))
+        same = sorted(
+            {t["pair"] for t in trials if t["same"]},
+            key=lambda p: ("happy", "sad", "angry", "afraid").index(p.split("-")[0]),
+        )
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
-        _bars(ax, same, [100 * _mean([t["correct"] for t in trials if t["pair"] == p]) for p in same],
-              THESIS["experiment2_same"], "Same-emotion pairs (cf. Fig. 3.14)")
-        rep.figure(fig, "fig314_same_pairs", "Same-emotion pairs judged 'same'. Orange: the percentages the thesis "
-                   "states for Experiment 2 (its Fig. 3.14 bars are not given as numbers).")
+        _bars(
+            ax,
+            same,
+            [100 * _mean([t["correct"] for t in trials if t["pair"] == p]) for p in same],
+            THESIS["experiment2_same"],
+            "Same-emotion pairs (cf. Fig. 3.14)",
+        )
+        rep.figure(
+            fig,
+            "fig314_same_pairs",
+            "Same-emotion pairs judged 'same'. Orange: the percentages the thesis "
+            "states for Experiment 2 (its Fig. 3.14 bars are not given as numbers).",
+        )
         # Figure 3.15: different pairs.
         diff = sorted({t["pair"] for t in trials if not t["same"]})
         thesis_diff = dict(THESIS["experiment2_different"])
         fig, ax = plt.subplots(figsize=(6.0, 3.6))
-        _bars(ax, diff, [100 * _mean([t["correct"] for t in trials if t["pair"] == p]) for p in diff],
-              thesis_diff, "Different-emotion pairs (cf. Fig. 3.15)")
-        rep.figure(fig, "fig315_different_pairs", "Different-emotion pairs judged 'different'. The thesis found "
-                   "happy–angry (both fast in Laban's Time) at chance in Experiment 1.")
+        _bars(
+            ax,
+            diff,
+            [100 * _mean([t["correct"] for t in trials if t["pair"] == p]) for p in diff],
+            thesis_diff,
+            "Different-emotion pairs (cf. Fig. 3.15)",
+        )
+        rep.figure(
+            fig,
+            "fig315_different_pairs",
+            "Different-emotion pairs judged 'different'. The thesis found "
+            "happy–angry (both fast in Laban's Time) at chance in Experiment 1.",
+        )
     # Figure 3.16: by frame rate (Experiment 2 design).
     exp2_trials = [t for t in result.trials if t["experiment"] == 2]
     if exp2_trials:
@@ -197,22 +238,36 @@ def _figures(rep: Report, result, table) -> None:
                 if not sel:
                     continue
                 rates = sorted({t["frame_rate"] for t in sel})
-                ax.plot(rates, [100 * _mean([t["correct"] for t in sel if t["frame_rate"] == r]) for r in rates],
-                        ls=ls, marker=mk, label=f"{method}, {comp}")
-        ax.axhline(THESIS["experiment2_overall"], color="#b03a2e", ls="--", lw=1, label="experts overall, Exp. 2 (78.99 %)")
+                ax.plot(
+                    rates,
+                    [100 * _mean([t["correct"] for t in sel if t["frame_rate"] == r]) for r in rates],
+                    ls=ls,
+                    marker=mk,
+                    label=f"{method}, {comp}",
+                )
+        ax.axhline(
+            THESIS["experiment2_overall"], color="#b03a2e", ls="--", lw=1, label="experts overall, Exp. 2 (78.99 %)"
+        )
         ax.set_xlabel("frame rate (Hz)")
         ax.set_ylabel("% correct")
         ax.set_ylim(0, 105)
         ax.set_title("By frame rate (cf. Fig. 3.16)", fontsize=10)
         ax.legend(fontsize=7, loc="lower right")
-        rep.figure(fig, "fig316_frame_rate", "Same/different accuracy by frame rate (Experiment 2 design: happy, sad, "
-                   "angry), with Neagle's key-frame-preserving resampling (solid) and naive decimation (dashed).")
+        rep.figure(
+            fig,
+            "fig316_frame_rate",
+            "Same/different accuracy by frame rate (Experiment 2 design: happy, sad, "
+            "angry), with Neagle's key-frame-preserving resampling (solid) and naive decimation (dashed).",
+        )
     # Recovery metrics by frame rate.
     fr = [t for t in table if t["factor"] in ("frame_rate", "baseline")]
     if fr:
         fig, axes = plt.subplots(1, 3, figsize=(11, 3.3))
-        for key, ax, lab in zip(("symbol_accuracy", "angle_error_deg", "time_abs_error"), axes,
-                                ("symbol accuracy", "limb angle error at key poses (deg)", "|Effort time error|")):
+        for key, ax, lab in zip(
+            ("symbol_accuracy", "angle_error_deg", "time_abs_error"),
+            axes,
+            ("symbol accuracy", "limb angle error at key poses (deg)", "|Effort time error|"),
+        ):
             for method, ls in (("keyframe", "-"), ("naive", "--")):
                 pts = sorted((_rate_of(t), t[key]) for t in fr if method in t["condition"] or "25 Hz" in t["condition"])
                 if pts:
@@ -222,14 +277,22 @@ def _figures(rep: Report, result, table) -> None:
             ax.legend(fontsize=7)
         rep.figure(fig, "recovery_frame_rate", "Notation and Effort recovery against frame rate.")
     # Other factors.
-    for factor, title in (("image_size", "image size"), ("view", "viewpoint"), ("compression", "compression"), ("noise", "pixel noise")):
+    for factor, title in (
+        ("image_size", "image size"),
+        ("view", "viewpoint"),
+        ("compression", "compression"),
+        ("noise", "pixel noise"),
+    ):
         if not any(t["factor"] == factor for t in table):
             continue
         lv = [t for t in _with_baseline(table, factor) if t["jobs"] > t["failed"]]
         fig, axes = plt.subplots(1, 3, figsize=(11, 3.3))
         labels = [_level(t, factor) for t in lv]
-        for key, ax, lab in zip(("symbol_accuracy", "angle_error_deg", "percent_correct"), axes,
-                                ("symbol accuracy", "limb angle error (deg)", "% correct (observer)")):
+        for key, ax, lab in zip(
+            ("symbol_accuracy", "angle_error_deg", "percent_correct"),
+            axes,
+            ("symbol accuracy", "limb angle error (deg)", "% correct (observer)"),
+        ):
             ax.bar(range(len(lv)), [t[key] for t in lv], color="#4a78b0")
             ax.set_xticks(range(len(lv)), labels, rotation=20)
             ax.set_title(lab, fontsize=9)
@@ -260,7 +323,13 @@ def _rate_of(t) -> float:
 
 def _level(t, factor) -> str:
     parts = t["condition"].split(", ")
-    levels = {"frame_rate": parts[0], "image_size": parts[1], "view": parts[2], "compression": parts[3], "noise": parts[4]}
+    levels = {
+        "frame_rate": parts[0],
+        "image_size": parts[1],
+        "view": parts[2],
+        "compression": parts[3],
+        "noise": parts[4],
+    }
     return levels.get(factor, t["condition"])
 
 
@@ -292,11 +361,28 @@ def write_report(result, outdir, capture_note: str = "") -> str:
     rep.heading("Same/different emotion judgements (Neagle Experiments 1–2)")
     _figures(rep, result, table)
     rep.heading("Every condition")
-    cols = ["factor", "condition", "jobs", "failed", "symbol_accuracy", "notation_accuracy", "angle_error_deg",
-            "timing_error_s", "mpjpe_mm", "time_abs_error", "weight_abs_error", "space_abs_error", "coverage",
-            "percent_correct"]
-    rep.table(table, cols, caption="Means over the test takes of each condition; percent_correct is Experiment 1's "
-              "design under that condition.")
+    cols = [
+        "factor",
+        "condition",
+        "jobs",
+        "failed",
+        "symbol_accuracy",
+        "notation_accuracy",
+        "angle_error_deg",
+        "timing_error_s",
+        "mpjpe_mm",
+        "time_abs_error",
+        "weight_abs_error",
+        "space_abs_error",
+        "coverage",
+        "percent_correct",
+    ]
+    rep.table(
+        table,
+        cols,
+        caption="Means over the test takes of each condition; percent_correct is Experiment 1's "
+        "design under that condition.",
+    )
     obs = summ.get("observer", {})
     rep.paragraph(
         f"Observer: says 'same' when the RMS of the scaled differences of {', '.join(obs.get('features', []))} is at most "

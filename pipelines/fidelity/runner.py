@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from capture2notation import __version__
+from capture2notation.atomic import write_text
 from capture2notation.compare.discrimination import (
     SameDifferentObserver,
     experiment1_trials,
@@ -35,13 +36,12 @@ from capture2notation.compare.discrimination import (
     summarise,
 )
 from capture2notation.errors import C2NError, PipelineError
-from capture2notation.io.atomic import write_text
 
 from .conditions import Condition, Job, build_conditions, build_jobs, phrase_complexity, stable_seed
 from .config import StudyConfig
 from .measure import builtin_scores, capture, kept_frames, measure, perform
 
-__all__ = ["STUDY_VERSION", "resolve_capture", "run_condition", "run_study", "StudyResult"]
+__all__ = ["STUDY_VERSION", "StudyResult", "resolve_capture", "run_condition", "run_study"]
 
 log = logging.getLogger(__name__)
 
@@ -53,8 +53,20 @@ IMAGE_FREE = ("truth", "keypoints")
 
 #: Columns of results.csv, in order (one row per job).
 ID_COLUMNS = (
-    "factor", "frame_rate", "resampling", "width", "height", "view", "compression", "noise",
-    "phrase", "complexity", "emotion", "take", "split", "capture",
+    "factor",
+    "frame_rate",
+    "resampling",
+    "width",
+    "height",
+    "view",
+    "compression",
+    "noise",
+    "phrase",
+    "complexity",
+    "emotion",
+    "take",
+    "split",
+    "capture",
 )
 
 
@@ -63,7 +75,9 @@ def resolve_capture(mode: str) -> str:
     return "keypoints" if mode == "auto" else mode
 
 
-def run_condition(job: Job, seed: int, capture_mode="truth", fps: float = 25.0, bootstrap: int = 30, scores=None) -> dict:
+def run_condition(
+    job: Job, seed: int, capture_mode="truth", fps: float = 25.0, bootstrap: int = 30, scores=None
+) -> dict:
     """Perform, record, capture and measure one job.
 
     Parameters
@@ -89,7 +103,7 @@ def run_condition(job: Job, seed: int, capture_mode="truth", fps: float = 25.0, 
         of a failure (metrics then absent), never a silent default.
     """
     c, p = job.condition, job.performance
-    row = {k: v for k, v in asdict(c).items()} | asdict(p)
+    row = dict(asdict(c).items()) | asdict(p)
     row["capture"] = capture_mode if isinstance(capture_mode, str) else getattr(capture_mode, "__name__", "custom")
     rng = np.random.default_rng(stable_seed("job", seed, *c.params(), *asdict(p).values()))
     t0 = time.perf_counter()
@@ -165,8 +179,14 @@ def _execute(pending, cfg, mode, scheduler, workers, progress, timeout=20.0):
         bar.close()
 
 
-def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: int | None = None,
-              progress: bool = True, connect_timeout: float = 20.0) -> StudyResult:
+def run_study(
+    cfg: StudyConfig,
+    outdir,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool = True,
+    connect_timeout: float = 20.0,
+) -> StudyResult:
     """Run (or resume) a study and write ``results.csv``, ``trials.csv`` and ``summary.json``.
 
     Parameters
@@ -224,9 +244,13 @@ def run_study(cfg: StudyConfig, outdir, scheduler: str | None = None, workers: i
     wall = time.perf_counter() - t0
     summary["config"] = cfg.as_dict()
     summary["capture"] = mode
-    summary["jobs"] = {"total": len(jobs), "ran": len(pending), "cached": len(jobs) - len(pending),
-                       "failed": sum(1 for r in rows if r.get("error")),
-                       "job_seconds": float(sum(r.get("seconds", 0.0) for r in rows))}
+    summary["jobs"] = {
+        "total": len(jobs),
+        "ran": len(pending),
+        "cached": len(jobs) - len(pending),
+        "failed": sum(1 for r in rows if r.get("error")),
+        "job_seconds": float(sum(r.get("seconds", 0.0) for r in rows)),
+    }
     write_text(outdir / "summary.json", json.dumps(summary, indent=2, sort_keys=True, default=_json_default))
     return StudyResult(rows, trials, summary, conditions, wall)
 
@@ -265,8 +289,14 @@ def rows_to_csv(rows: list[dict]) -> str:
 
 
 def _features(r: dict) -> np.ndarray:
-    return feature_vector({"time": r.get("time_est"), "weight": r.get("weight_est"),
-                           "space": r.get("space_est"), "tempo": r.get("tempo_obs")})
+    return feature_vector(
+        {
+            "time": r.get("time_est"),
+            "weight": r.get("weight_est"),
+            "space": r.get("space_est"),
+            "tempo": r.get("tempo_obs"),
+        }
+    )
 
 
 def discrimination(rows: list[dict], cfg: StudyConfig, conditions: list[Condition]) -> tuple[list, dict]:
@@ -289,8 +319,11 @@ def discrimination(rows: list[dict], cfg: StudyConfig, conditions: list[Conditio
     all_trials, per_condition = [], []
     for c in conditions:
         pool = {k: np.array(v) for k, v in by_cond.get(c.params(), {}).items()}
-        comps = tuple(x for x in complexities if all((e, x, c.rate) in pool and len(pool[(e, x, c.rate)]) >= 2
-                                                      for e in cfg.emotions))
+        comps = tuple(
+            x
+            for x in complexities
+            if all((e, x, c.rate) in pool and len(pool[(e, x, c.rate)]) >= 2 for e in cfg.emotions)
+        )
         if not comps:
             continue
         trials = experiment1_trials(comps, cfg.emotions, c.rate)
@@ -299,9 +332,18 @@ def discrimination(rows: list[dict], cfg: StudyConfig, conditions: list[Conditio
             t.update({"experiment": 1, "condition": c.label, "factor": c.factor, "resampling": c.resampling})
         all_trials += res
         s = summarise(res)
-        per_condition.append({"condition": c.label, "factor": c.factor, **{k: v for k, v in asdict(c).items()},
-                              "percent_correct": s["overall"], "by_pair": s["by_pair"],
-                              "by_complexity": s["by_complexity"], "by_kind": s["by_kind"], "n": s["n"]})
+        per_condition.append(
+            {
+                "condition": c.label,
+                "factor": c.factor,
+                **dict(asdict(c).items()),
+                "percent_correct": s["overall"],
+                "by_pair": s["by_pair"],
+                "by_complexity": s["by_complexity"],
+                "by_kind": s["by_kind"],
+                "n": s["n"],
+            }
+        )
     exp2 = {}
     emos2 = tuple(e for e in ("happy", "sad", "angry") if e in cfg.emotions)
     comps2 = tuple(x for x in ("easy", "hard") if x in complexities) or complexities[:1]
@@ -323,8 +365,9 @@ def discrimination(rows: list[dict], cfg: StudyConfig, conditions: list[Conditio
             continue
         res = run_trials(trials, pool, obs, np.random.default_rng(stable_seed("exp2", cfg.seed, method)))
         for t in res:
-            t.update({"experiment": 2, "condition": f"frame rates, {method}", "factor": "frame_rate",
-                      "resampling": method})
+            t.update(
+                {"experiment": 2, "condition": f"frame rates, {method}", "factor": "frame_rate", "resampling": method}
+            )
         all_trials += res
         exp2[method] = summarise(res)
     summary = {"observer": obs.as_dict(), "experiment1": per_condition, "experiment2": exp2}

@@ -45,8 +45,9 @@ def render_frames(pose: Pose, camera: Camera, style: str = "mannequin") -> Itera
         yield r.frame(i)
 
 
-def truth_fields(pose: Pose, camera: Camera, *, score_json: str = "null", effort_json: str = "null",
-                 view: str = "", style: str = "") -> dict:
+def truth_fields(
+    pose: Pose, camera: Camera, *, score_json: str = "null", effort_json: str = "null", view: str = "", style: str = ""
+) -> dict:
     """Every field of the truth sidecar for `pose` seen by `camera`.
 
     Returns

@@ -50,10 +50,24 @@ PALETTE: dict[str, tuple[int, int, int]] = {
     "shadow": (160, 166, 172),
 }
 _PART_COLOUR = {
-    "neck": "skin", "head": "skin", "shoulders": "shirt", "chest": "shirt", "belly": "shirt",
-    "pelvis": "trousers", "hips": "trousers",
-    "upper_arm": "shirt", "forearm": "skin", "hand": "skin", "fingers": "skin", "thumb": "skin",
-    "thigh": "trousers", "shin": "trousers", "lower_leg": "skin", "foot": "shoes", "instep": "shoes", "toes": "shoes",
+    "neck": "skin",
+    "head": "skin",
+    "shoulders": "shirt",
+    "chest": "shirt",
+    "belly": "shirt",
+    "pelvis": "trousers",
+    "hips": "trousers",
+    "upper_arm": "shirt",
+    "forearm": "skin",
+    "hand": "skin",
+    "fingers": "skin",
+    "thumb": "skin",
+    "thigh": "trousers",
+    "shin": "trousers",
+    "lower_leg": "skin",
+    "foot": "shoes",
+    "instep": "shoes",
+    "toes": "shoes",
 }
 #: Drawn radii (fractions of body height) that differ from the body volume of
 #: :data:`~.scene.CAPSULES`, which the truth's visibility keeps using: the
@@ -87,8 +101,19 @@ _RING_POINTS = 10
 _COLLAR = ((-0.046, 0.040, 0.836), (0.046, 0.040, 0.836), (0.0, 0.062, 0.766))
 # Head ellipses: (scale, shift towards the light in semi-axes).
 _HEAD_LAYERS = ((1.0, 0.0), (0.86, 0.10), (0.45, 0.35))
-_FACE_POINTS = ("left_eye", "right_eye", "nose", "mouth_left", "mouth_right", "left_ear", "right_ear",
-                "left_eye_inner", "right_eye_inner", "left_eye_outer", "right_eye_outer")
+_FACE_POINTS = (
+    "left_eye",
+    "right_eye",
+    "nose",
+    "mouth_left",
+    "mouth_right",
+    "left_ear",
+    "right_ear",
+    "left_eye_inner",
+    "right_eye_inner",
+    "left_eye_outer",
+    "right_eye_outer",
+)
 
 
 def fixed(p: np.ndarray) -> np.ndarray:
@@ -156,7 +181,7 @@ def _unsided(name: str) -> str:
     """``right_upper_arm`` → ``upper_arm``."""
     for side in ("right_", "left_"):
         if name.startswith(side):
-            return name[len(side):]
+            return name[len(side) :]
     return name
 
 
@@ -214,9 +239,14 @@ class Mannequin:
         self._collar_colour = _gain(PALETTE["skin"], 0.9)
         skin, hair = PALETTE["skin"], PALETTE["hair"]
         self._head_colours = {
-            "skin": skin, "skin_rim": _gain(skin, 0.62), "skin_light": _gain(skin, 1.08),
-            "hair": hair, "hair_rim": _gain(hair, 0.62), "ear": _gain(skin, 0.8),
-            "nose_rim": _gain(skin, 0.72), "nose": _gain(skin, 0.98),
+            "skin": skin,
+            "skin_rim": _gain(skin, 0.62),
+            "skin_light": _gain(skin, 1.08),
+            "hair": hair,
+            "hair_rim": _gain(hair, 0.62),
+            "ear": _gain(skin, 0.8),
+            "nose_rim": _gain(skin, 0.72),
+            "nose": _gain(skin, 0.98),
         }
         self._shadow = self._shadow_polygons()
 
@@ -267,8 +297,10 @@ class Mannequin:
         out["thin"] = np.maximum(1, np.round(0.007 * s)).astype(int).tolist()
         pts = {n: cam.project(pose.points[n]) for n in _FACE_POINTS}
         # Outward normals of the features decide which ones face the camera.
-        cos = {n: np.sum((pose.points[n] - centre) * to_cam, 1) / np.linalg.norm(pose.points[n] - centre, axis=1)
-               for n in _FACE_POINTS}
+        cos = {
+            n: np.sum((pose.points[n] - centre) * to_cam, 1) / np.linalg.norm(pose.points[n] - centre, axis=1)
+            for n in _FACE_POINTS
+        }
         side = np.sum(axes[:, 0] * to_cam, axis=1)  # > 0: the right ear is seen
         facing_cos = np.sum(axes[:, 1] * to_cam, axis=1)
         facing = facing_cos > -0.3
@@ -280,8 +312,12 @@ class Mannequin:
         r = np.maximum(1.0, 0.016 * s)
         ear_axes = fixed(np.stack([0.6 * r, r], 1)).tolist()
         out["ears"] = [
-            ((side > -0.35) & (cos["right_ear"] > -0.35)).tolist(), fixed(pts["right_ear"]).tolist(), ear_axes,
-            ((side < 0.35) & (cos["left_ear"] > -0.35)).tolist(), fixed(pts["left_ear"]).tolist(), ear_axes,
+            ((side > -0.35) & (cos["right_ear"] > -0.35)).tolist(),
+            fixed(pts["right_ear"]).tolist(),
+            ear_axes,
+            ((side < 0.35) & (cos["left_ear"] > -0.35)).tolist(),
+            fixed(pts["left_ear"]).tolist(),
+            ear_axes,
         ]
         up = pts["left_eye"] + pts["right_eye"] - pts["mouth_left"] - pts["mouth_right"]
         up /= np.maximum(np.linalg.norm(up, axis=1, keepdims=True), 1e-9)
@@ -291,22 +327,25 @@ class Mannequin:
             half = np.maximum(1.0, 0.5 * np.linalg.norm(outer - inner, axis=1))
             d = outer - inner
             brow = up * 1.1 * half[:, None]
-            out["eyes"].append((
-                (facing & (cos[f"{side_name}_eye"] > 0.1)).tolist(),
-                fixed(pts[f"{side_name}_eye"]).tolist(),
-                fixed(np.stack([half, 0.55 * half], 1)).tolist(),
-                np.degrees(np.arctan2(d[:, 1], d[:, 0])).tolist(),
-                np.round(np.maximum(0.8, 0.45 * half) * _ONE).astype(int).tolist(),
-                fixed(inner + brow).tolist(),
-                fixed(outer + 0.8 * brow).tolist(),
-            ))
+            out["eyes"].append(
+                (
+                    (facing & (cos[f"{side_name}_eye"] > 0.1)).tolist(),
+                    fixed(pts[f"{side_name}_eye"]).tolist(),
+                    fixed(np.stack([half, 0.55 * half], 1)).tolist(),
+                    np.degrees(np.arctan2(d[:, 1], d[:, 0])).tolist(),
+                    np.round(np.maximum(0.8, 0.45 * half) * _ONE).astype(int).tolist(),
+                    fixed(inner + brow).tolist(),
+                    fixed(outer + 0.8 * brow).tolist(),
+                )
+            )
         # The nose: a small tapered capsule from its root to its tip, which
         # rounds the profile (a nose standing further out of the head measured
         # slightly worse with BlazePose at the body joints).
         (r_uv, r_z), (t_uv, t_z) = cam.project(pose.points["nose_root"], True), cam.project(pose.points["nose"], True)
         out["nose"] = (facing & (cos["nose"] > -0.25)).tolist()
-        out["nose_polys"] = [fixed(capsule_outlines(r_uv, t_uv, sc * 0.008 * H * f / r_z, sc * 0.011 * H * f / t_z))
-                             for sc in (1.0, 0.6)]
+        out["nose_polys"] = [
+            fixed(capsule_outlines(r_uv, t_uv, sc * 0.008 * H * f / r_z, sc * 0.011 * H * f / t_z)) for sc in (1.0, 0.6)
+        ]
         out["mouth"] = (facing & (np.maximum(cos["mouth_left"], cos["mouth_right"]) > 0.0)).tolist()
         out["mouth_pts"] = (fixed(pts["mouth_left"]).tolist(), fixed(pts["mouth_right"]).tolist())
         return out
@@ -365,7 +404,11 @@ class Mannequin:
             cv2.fillConvexPoly(img, self._collar[i], self._collar_colour, cv2.LINE_AA, SHIFT)
 
     def _ellipse(self, img, key: str, scale: float, i: int, colour) -> None:
-        centre, half, angle = self._head[(key, scale)][0][i], self._head[(key, scale)][1][i], self._head[(key, scale)][2][i]
+        centre, half, angle = (
+            self._head[(key, scale)][0][i],
+            self._head[(key, scale)][1][i],
+            self._head[(key, scale)][2][i],
+        )
         cv2.ellipse(img, centre, half, angle, 0, 360, colour, -1, cv2.LINE_AA, SHIFT)
 
     def _draw_head(self, img, i: int) -> None:

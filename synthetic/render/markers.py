@@ -14,24 +14,13 @@ from types import MappingProxyType
 import cv2
 import numpy as np
 
+from capture2notation.keypoints.markers import MARKER_HSV, MARKER_JOINTS
+
 from .camera import Camera
 from .mannequin import SHIFT, capsule_outlines, fixed
 from .scene import Pose, body_capsules, floor_background, point_visibility
 
 __all__ = ["MARKER_COLOURS", "MARKER_HSV", "MARKER_JOINTS", "MARKER_RADIUS", "Markers"]
-
-#: Joints that carry a marker.
-MARKER_JOINTS: tuple[str, ...] = (
-    "head", "neck",
-    "right_shoulder", "right_elbow", "right_wrist", "right_hand_tip",
-    "left_shoulder", "left_elbow", "left_wrist", "left_hand_tip",
-    "right_hip", "right_knee", "right_ankle", "right_toe",
-    "left_hip", "left_knee", "left_ankle", "left_toe",
-)
-#: OpenCV HSV (H in 0-179, S, V) of each marker: hue 10·((7·k) mod 18).
-MARKER_HSV: MappingProxyType = MappingProxyType(
-    {j: (10 * ((7 * k) % 18), 255, 255) for k, j in enumerate(MARKER_JOINTS)}
-)
 
 
 def _hsv_to_bgr(hsv) -> tuple[int, int, int]:
@@ -89,6 +78,13 @@ class Markers:
             cv2.fillConvexPoly(img, self._polys[i, k], _SILHOUETTE, cv2.LINE_AA, SHIFT)
         for m in self._order[i]:
             if self.visible[i, m]:
-                cv2.circle(img, tuple(int(v) for v in self._uv[i, m]), int(self._r[i, m]),
-                           self._colours[m], -1, cv2.LINE_AA, SHIFT)
+                cv2.circle(
+                    img,
+                    tuple(int(v) for v in self._uv[i, m]),
+                    int(self._r[i, m]),
+                    self._colours[m],
+                    -1,
+                    cv2.LINE_AA,
+                    SHIFT,
+                )
         return img

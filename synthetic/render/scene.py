@@ -163,8 +163,14 @@ class Pose:
         points = {n: joints[:, i] for i, n in enumerate(JOINTS)}
         points.update({n: lms[:, i] for i, n in enumerate(BLAZEPOSE_LANDMARKS)})
         points.update({n: extra[:, i] for i, n in enumerate(names)})
-        for name, value in (("angles", angles), ("root", root), ("joints", joints),
-                            ("rotations", rot), ("landmarks", lms), ("points", points)):
+        for name, value in (
+            ("angles", angles),
+            ("root", root),
+            ("joints", joints),
+            ("rotations", rot),
+            ("landmarks", lms),
+            ("points", points),
+        ):
             object.__setattr__(self, name, value)
         object.__setattr__(self, "fps", float(self.fps))
 
@@ -232,10 +238,12 @@ def point_visibility(
     (T, N) ndarray of bool
     """
     if len(points) > _CHUNK:  # bound the (T, N, P) temporaries on long takes
-        return np.concatenate([
-            point_visibility(camera, points[i:i + _CHUNK], a[i:i + _CHUNK], b[i:i + _CHUNK], radii, tolerance)
-            for i in range(0, len(points), _CHUNK)
-        ])
+        return np.concatenate(
+            [
+                point_visibility(camera, points[i : i + _CHUNK], a[i : i + _CHUNK], b[i : i + _CHUNK], radii, tolerance)
+                for i in range(0, len(points), _CHUNK)
+            ]
+        )
     pc = camera.to_camera(points)  # (T,N,3)
     ac, bc = camera.to_camera(a), camera.to_camera(b)
     f = camera.K[1, 1]

@@ -58,6 +58,7 @@ class Stick:
         """The image of frame `i`, (H, W, 3) uint8 BGR."""
         img = self.background.copy()
         cv2.polylines(img, list(self._lines[i]), False, (0, 0, 0), self._width, cv2.LINE_AA, SHIFT)
-        cv2.circle(img, tuple(int(v) for v in self._head[i]), int(self._radius[i]), (0, 0, 0),
-                   self._width, cv2.LINE_AA, SHIFT)
+        cv2.circle(
+            img, tuple(int(v) for v in self._head[i]), int(self._radius[i]), (0, 0, 0), self._width, cv2.LINE_AA, SHIFT
+        )
         return img

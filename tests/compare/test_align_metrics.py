@@ -156,8 +156,10 @@ def test_compare_movements_verdicts():
 
 
 def test_effort_differences_interval():
-    d = effort_differences({"time": (-3.0, -3.4, -2.6), "weight": (0.5, 0.5, 0.5)},
-                           {"time": (-2.4, -2.5, -2.3), "weight": (0.4, 0.35, 0.45)})
+    d = effort_differences(
+        {"time": (-3.0, -3.4, -2.6), "weight": (0.5, 0.5, 0.5)},
+        {"time": (-2.4, -2.5, -2.3), "weight": (0.4, 0.35, 0.45)},
+    )
     assert d["time"]["difference"] == pytest.approx(-0.6)
     assert (d["time"]["lo"], d["time"]["hi"]) == pytest.approx((-1.1, -0.1))
     assert not d["time"]["consistent"]

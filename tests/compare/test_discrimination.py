@@ -32,7 +32,14 @@ def test_experiment2_design_counts():
     trials = experiment2_trials()
     assert len(trials) == 96
     assert {t.frame_rate for t in trials} == {Fraction(5), Fraction(25, 3), Fraction(25, 2), Fraction(25)}
-    assert {t.pair for t in trials} == {"happy-happy", "sad-sad", "angry-angry", "happy-sad", "happy-angry", "sad-angry"}
+    assert {t.pair for t in trials} == {
+        "happy-happy",
+        "sad-sad",
+        "angry-angry",
+        "happy-sad",
+        "happy-angry",
+        "sad-angry",
+    }
     assert THESIS["experiment1_overall"] == pytest.approx(78.70)
 
 
@@ -40,8 +47,9 @@ def performances(rng, n_takes, noise):
     """Takes of each preset with Gaussian jitter on the observer's features."""
     feats, emos = [], []
     for name, p in PRESETS.items():
-        base = feature_vector({"time": p.effort.time, "weight": p.effort.weight,
-                               "space": p.effort.space, "tempo": float(p.tempo)})
+        base = feature_vector(
+            {"time": p.effort.time, "weight": p.effort.weight, "space": p.effort.space, "tempo": float(p.tempo)}
+        )
         for _ in range(n_takes):
             feats.append(base + rng.normal(scale=noise, size=4))
             emos.append(name)

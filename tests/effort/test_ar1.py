@@ -6,8 +6,8 @@ from scipy import linalg
 
 from capture2notation.effort.fit import fit_space
 from capture2notation.effort.likelihood import RHO_RANGE, Batch
-from capture2notation.effort.model import progress
 from capture2notation.effort.posterior import sample_posteriors
+from capture2notation.notation.effort import progress
 
 TAU = np.arange(1, 25) / 25
 #: a missing frame (τ = 10/25): the gap correlates as ρ²

@@ -7,10 +7,10 @@ import pytest
 
 from capture2notation.body import joint_index
 from capture2notation.effort.curves import progress_curve
-from capture2notation.effort.model import progress
-from capture2notation.effort.testing import arc_motion
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress
 from capture2notation.notation.model import Effort, Score, Symbol
+from synthetic.arcs import arc_motion
 
 
 def _one_move(effort, fps=25.0, tempo=60, beats=2, snap=True):

@@ -10,8 +10,8 @@ from capture2notation.effort.emotion import (
     preset_features,
     same_or_different,
 )
-from capture2notation.effort.presets import PRESETS
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import PRESETS
 
 
 @pytest.mark.parametrize("emotion", list(PRESETS))

@@ -9,10 +9,10 @@ from click.testing import CliRunner
 
 from capture2notation.body import joint_index
 from capture2notation.effort import estimate_effort, progress, write_effort
-from capture2notation.effort.testing import arc_motion, random_arm_score
 from capture2notation.errors import EffortError
 from capture2notation.notation import Score, Symbol, write
 from capture2notation.notation.model import Effort
+from synthetic.arcs import arc_motion, random_arm_score
 
 FIELDS = {"part", "start", "duration", "time", "weight", "space", "tau", "acceptance", "converged"}
 
@@ -50,7 +50,7 @@ def test_effort_json_has_the_issue_fields(angry, tmp_path):
     data = json.loads(paths["json"].read_text())
     assert len(data["movements"]) == 3
     for m in data["movements"]:
-        assert FIELDS <= set(m)
+        assert set(m) >= FIELDS
         assert m["time"]["ci90"][0] <= m["time"]["median"] <= m["time"]["ci90"][1]
         assert 0 <= m["space"]["ci90"][0] <= m["space"]["ci90"][1] <= 1
         # AR(1) residual correlation: 4 mm joint noise is white
@@ -91,8 +91,10 @@ def test_chunked_sampling_keeps_order_and_does_not_depend_on_workers(monkeypatch
 
 
 def test_unmeasurable_movements_are_skipped_with_a_reason():
-    score = Score(symbols=(Symbol(0, 1, "right_arm", "forward", "middle"), Symbol(3, 2, "left_arm", "right", "high")),
-                  tempo=Fraction(60))
+    score = Score(
+        symbols=(Symbol(0, 1, "right_arm", "forward", "middle"), Symbol(3, 2, "left_arm", "right", "high")),
+        tempo=Fraction(60),
+    )
     joints = arc_motion(score, 25.0)[:60]  # the second movement runs past the capture
     joints[:, joint_index("left_wrist")] = np.nan
     res = estimate_effort(joints, None, 25.0, score, rng=0)

@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from capture2notation.effort.fit import fit_logistic, fit_logistic_many, fit_space
-from capture2notation.effort.model import progress
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress
 
 TAU = np.arange(1, 30) / 30
 

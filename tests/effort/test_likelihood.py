@@ -5,9 +5,9 @@ import pytest
 from scipy import special
 
 from capture2notation.effort.likelihood import Batch, log_gammainc
-from capture2notation.effort.model import progress
 from capture2notation.effort.posterior import LOG_SIGMA_RANGE, log_probability
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress
 
 TAU = np.arange(1, 25) / 25
 THETA = np.array([[-2.4, 0.6], [-2.45, 0.61], [-3.0, 0.5]])
@@ -71,12 +71,12 @@ def test_batch_groups_are_evaluated_independently():
     theta[2] = (-5.5, 0.5)  # outside the prior box
     batch = Batch(sets)
     together = batch.log_marginal(theta)
-    alone = np.concatenate([Batch([d]).log_marginal(theta[g * k:(g + 1) * k]) for g, d in enumerate(sets)])
+    alone = np.concatenate([Batch([d]).log_marginal(theta[g * k : (g + 1) * k]) for g, d in enumerate(sets)])
     np.testing.assert_allclose(together, alone, rtol=1e-12)
     assert np.isneginf(together[2]) and np.isfinite(np.delete(together, 2)).all()
     # a subset of groups, in another order, gives the same rows
-    sub = batch.log_marginal(np.concatenate([theta[2 * k:], theta[:k]]), groups=(2, 0))
-    np.testing.assert_allclose(sub, np.concatenate([together[2 * k:], together[:k]]), rtol=1e-12)
+    sub = batch.log_marginal(np.concatenate([theta[2 * k :], theta[:k]]), groups=(2, 0))
+    np.testing.assert_allclose(sub, np.concatenate([together[2 * k :], together[:k]]), rtol=1e-12)
 
 
 def test_log_sigma_draws_follow_the_conditional():

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from capture2notation.effort.model import progress, progress_speed, space_radius
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress, progress_speed, space_radius
 
 b_st = st.floats(-5.0, -1.5)
 x0_st = st.floats(0.1, 0.9)

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from capture2notation.effort.curves import ProgressCurve
-from capture2notation.effort.model import progress
 from capture2notation.effort.pooled import pool_curves, pooled_posterior
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress
 
 
 def _curve(n, seed, b=-2.8, x0=0.5, space=0.5):

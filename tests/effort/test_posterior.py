@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from capture2notation.effort.model import progress
 from capture2notation.effort.posterior import (
     LOG_SIGMA_RANGE,
     log_probability,
@@ -11,6 +10,7 @@ from capture2notation.effort.posterior import (
     sample_posteriors,
 )
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress
 
 TAU = np.arange(1, 25) / 25
 
@@ -35,9 +35,7 @@ def test_log_probability_is_the_gaussian_likelihood_of_the_model():
 def test_outside_the_prior_box_is_impossible():
     s = _data()
     w = np.ones_like(TAU)
-    theta = np.array(
-        [[-5.1, 0.5, -3.0], [-1.4, 0.5, -3.0], [-2.5, 0.96, -3.0], [-2.5, 0.5, LOG_SIGMA_RANGE[1] + 0.1]]
-    )
+    theta = np.array([[-5.1, 0.5, -3.0], [-1.4, 0.5, -3.0], [-2.5, 0.96, -3.0], [-2.5, 0.5, LOG_SIGMA_RANGE[1] + 0.1]])
     assert np.all(np.isneginf(log_probability(theta, TAU, s, w)))
 
 
@@ -93,7 +91,7 @@ def test_free_ends_are_marginalised_exactly():
         m = progress(TAU, b, x0)
         pred = c[:, None, None] + k[None, :, None] * m  # (C, K, N)
         chi2 = np.sum(w * (s - pred) ** 2, axis=2)
-        like = np.exp(-0.5 * chi2 / sig**2) / sig ** TAU.size
+        like = np.exp(-0.5 * chi2 / sig**2) / sig**TAU.size
         brute.append(np.log(np.trapezoid(np.trapezoid(like, k, axis=1), c)))
     got = log_probability(thetas, TAU, s, w, onehot)
     # equal up to one constant (the flat priors' normaliser and 2π)

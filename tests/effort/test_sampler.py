@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 
 from capture2notation.effort.likelihood import Batch
-from capture2notation.effort.model import progress
 from capture2notation.effort.sampler import (
     N_TAU,
     GroupedDEMove,
@@ -13,6 +12,7 @@ from capture2notation.effort.sampler import (
     run_groups,
 )
 from capture2notation.errors import EffortError
+from capture2notation.notation.effort import progress
 
 TAU = np.arange(1, 25) / 25
 
@@ -54,8 +54,9 @@ def test_a_posterior_in_a_batch_matches_it_sampled_alone():
     truths = [(-2.6, 0.55), (-3.9, 0.4)]
     batch = _batch(truths, seed=5)
     together = run_groups(batch, truths, np.full((2, 2), 0.01), np.random.default_rng(3))[0].samples()
-    alone = run_groups(_batch(truths[:1], seed=5), truths[:1], np.full((1, 2), 0.01),
-                       np.random.default_rng(4))[0].samples()
+    alone = run_groups(_batch(truths[:1], seed=5), truths[:1], np.full((1, 2), 0.01), np.random.default_rng(4))[
+        0
+    ].samples()
     for col in (0, 1):
         lo, hi = np.percentile(alone[:, col], [5, 95])
         # medians agree to a small fraction of the 90 % width; widths to 20 %
@@ -101,7 +102,7 @@ def test_a_posterior_with_no_sound_starting_walker_is_refused_by_name():
 
     def second_group_impossible(theta, groups=None):
         out = plain(theta, groups)
-        out[len(out) // 2:] = -np.inf
+        out[len(out) // 2 :] = -np.inf
         return out
 
     batch.log_marginal = second_group_impossible

@@ -8,9 +8,9 @@ import pytest
 from capture2notation.effort import estimate_effort, progress_curve
 from capture2notation.effort.fit import NO_SPACE, fit_space
 from capture2notation.effort.pooled import curve_space, pooled_space
-from capture2notation.effort.testing import arc_motion, random_arm_score
 from capture2notation.notation import Score, Symbol
 from capture2notation.notation.model import Effort
+from synthetic.arcs import arc_motion, random_arm_score
 
 FPS = 25.0
 TAU = np.linspace(0.02, 0.98, 49)
@@ -23,8 +23,9 @@ def _arm_curves(space, noise=0.0, seed=3, n_moves=3):
     if noise:
         joints = joints + noise * rng.standard_normal(joints.shape)
     times = np.arange(joints.shape[0]) / FPS
-    return [progress_curve(joints, None, times, s.part, score.seconds(s.start), score.seconds(s.end))
-            for s in score.symbols]
+    return [
+        progress_curve(joints, None, times, s.part, score.seconds(s.start), score.seconds(s.end)) for s in score.symbols
+    ]
 
 
 @pytest.mark.parametrize("space", [0.0, 1.0])
@@ -49,7 +50,6 @@ def test_head_movements_do_not_pull_pooled_space_to_direct():
         tempo=Fraction(60),
         effort=Effort(-2.5, 0.5, 0.0),
     )
-    pytest.importorskip("synthetic.interpret")
     from synthetic.interpret import interpret
 
     joints = interpret(score, fps=FPS).joints()
@@ -63,7 +63,6 @@ def test_head_movements_do_not_pull_pooled_space_to_direct():
 def test_bent_arms_reaching_outward_read_as_indirect():
     # rounded arms (bend=1 at both ends) reach outward (eq. 5.6) by only
     # (L − r)/r ≈ 3.5 % at S = 0; read against the inward 10 % they gave S ≈ 0.66
-    pytest.importorskip("synthetic.interpret")
     from synthetic.interpret import interpret
 
     syms = []
@@ -73,8 +72,9 @@ def test_bent_arms_reaching_outward_read_as_indirect():
         score = Score(symbols=tuple(syms), tempo=Fraction(60), effort=Effort(-2.5, 0.5, space))
         joints = interpret(score, fps=FPS).joints()
         times = np.arange(joints.shape[0]) / FPS
-        curves = [progress_curve(joints, None, times, s.part, score.seconds(s.start), score.seconds(s.end))
-                  for s in syms[1:]]  # the first starts from the straight rest pose
+        curves = [
+            progress_curve(joints, None, times, s.part, score.seconds(s.start), score.seconds(s.end)) for s in syms[1:]
+        ]  # the first starts from the straight rest pose
         for c in curves:
             assert c.shows_space and np.all(c.outward > 0.01)
             assert abs(curve_space(c).median - space) < 0.05

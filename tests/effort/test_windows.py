@@ -8,9 +8,9 @@ import pytest
 
 from capture2notation.effort import estimate_effort
 from capture2notation.effort.curves import progress_curve, refine_window
-from capture2notation.effort.testing import arc_motion
 from capture2notation.notation import Score, Symbol
 from capture2notation.notation.model import Effort
+from synthetic.arcs import arc_motion
 
 FPS = 25.0
 
@@ -54,9 +54,13 @@ def test_window_cut_short_at_both_ends_recovers_b_and_x0(b, x0):
         (-2.3, 0.6),
         (-2.0, 0.75),
         pytest.param(
-            -4.2, 0.35,
-            marks=pytest.mark.xfail(strict=True, reason="an early, sudden movement creeps to its end below 10 % of "
-                                    "its peak speed: that end stays cut and x0 reads late"),
+            -4.2,
+            0.35,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="an early, sudden movement creeps to its end below 10 % of "
+                "its peak speed: that end stays cut and x0 reads late",
+            ),
         ),
     ],
 )

@@ -11,12 +11,19 @@ from capture2notation.fitting.fit import TARGETS_2D
 
 # (joint, axis, amplitude rad, one-sided): smooth swings of arms, legs, trunk.
 _SWINGS = (
-    ("right_shoulder", 0, 1.5, True), ("right_shoulder", 1, -1.2, True),
-    ("left_shoulder", 0, 1.2, True), ("left_shoulder", 1, 1.0, True),
-    ("right_elbow", 0, 1.2, True), ("left_elbow", 0, 1.0, True),
-    ("right_hip", 0, 0.8, True), ("left_hip", 1, 0.4, True),
-    ("right_knee", 0, -1.0, True), ("left_knee", 0, -0.6, True),
-    ("waist", 0, 0.3, False), ("neck", 0, 0.3, False), ("pelvis", 2, 0.8, False),
+    ("right_shoulder", 0, 1.5, True),
+    ("right_shoulder", 1, -1.2, True),
+    ("left_shoulder", 0, 1.2, True),
+    ("left_shoulder", 1, 1.0, True),
+    ("right_elbow", 0, 1.2, True),
+    ("left_elbow", 0, 1.0, True),
+    ("right_hip", 0, 0.8, True),
+    ("left_hip", 1, 0.4, True),
+    ("right_knee", 0, -1.0, True),
+    ("left_knee", 0, -0.6, True),
+    ("waist", 0, 0.3, False),
+    ("neck", 0, 0.3, False),
+    ("pelvis", 2, 0.8, False),
 )
 
 
@@ -83,5 +90,6 @@ def synth():
     """The helpers above: ``synth.make_motion``, ``synth.observe``, ``synth.limb_direction_errors``."""
     from types import SimpleNamespace
 
-    return SimpleNamespace(make_motion=make_motion, held_pose=held_pose, observe=observe,
-                           limb_direction_errors=limb_direction_errors)
+    return SimpleNamespace(
+        make_motion=make_motion, held_pose=held_pose, observe=observe, limb_direction_errors=limb_direction_errors
+    )

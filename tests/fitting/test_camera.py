@@ -58,5 +58,5 @@ def test_points_behind_the_camera_project_to_nan():
 def test_bad_cameras_are_rejected(kwargs, message):
     with pytest.raises(FittingError, match=message):
         Camera(**kwargs)
-    with pytest.raises(FittingError, match="missing|no camera field"):
+    with pytest.raises(FittingError, match=r"missing|no camera field"):
         Camera.from_truth({"K": np.eye(3)})

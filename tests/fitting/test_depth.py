@@ -24,7 +24,10 @@ def test_one_candidate_is_the_true_arm_and_all_project_onto_the_same_pixels():
     f = rng.normal(size=(20, 3))
     E = S + 0.3 * u / np.linalg.norm(u, axis=1, keepdims=True)
     W = E + 0.25 * f / np.linalg.norm(f, axis=1, keepdims=True)
-    px = lambda p: p[..., :2] / p[..., 2:] * CAM.focal + CAM.K[:2, 2]
+
+    def px(p):
+        return p[..., :2] / p[..., 2:] * CAM.focal + CAM.K[:2, 2]
+
     e_c, w_c = arm_candidates(CAM, S, px(E), px(W), 0.3, 0.25)
     err = np.linalg.norm(e_c - E[:, None], axis=-1) + np.linalg.norm(w_c - W[:, None], axis=-1)
     assert np.all(err.min(axis=1) < 1e-6)
@@ -74,12 +77,16 @@ def test_a_bent_elbow_tells_the_forearm_side_when_world_depth_says_nothing(synth
     world[:, [16, 20], 2] = world[:, [14], 2]
     assert np.all(_depth_sign(truth, "right_elbow", "right_wrist") < 0)
     res = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world)
-    fore = CAM.to_camera(res.joints[:, joint_index("right_wrist")]) - CAM.to_camera(res.joints[:, joint_index("right_elbow")])
+    fore = CAM.to_camera(res.joints[:, joint_index("right_wrist")]) - CAM.to_camera(
+        res.joints[:, joint_index("right_elbow")]
+    )
     towards = -fore[:, 2] / np.linalg.norm(fore, axis=1)
     assert np.mean(towards > 0.5) >= 0.9, towards  # at least 30° towards the camera
     # Without the choice the side is left to chance (measured: behind).
     off = fit_keypoints(xy, conf, 25.0, camera=CAM, world=world, options=FitOptions(depth=None))
-    fore_off = CAM.to_camera(off.joints[:, joint_index("right_wrist")]) - CAM.to_camera(off.joints[:, joint_index("right_elbow")])
+    fore_off = CAM.to_camera(off.joints[:, joint_index("right_wrist")]) - CAM.to_camera(
+        off.joints[:, joint_index("right_elbow")]
+    )
     assert np.mean(-fore_off[:, 2] / np.linalg.norm(fore_off, axis=1)) < np.mean(towards)
 
 
@@ -91,10 +98,13 @@ _LIMBS = {
 }
 
 
-@pytest.mark.parametrize("limb, pose, rest, seed", [
-    ("arm", {"right_shoulder": (0.785, 0.0, 0.0)}, 12, 5),
-    ("leg", {"right_hip": (0.6, 0.0, 0.0)}, 30, 6),
-])
+@pytest.mark.parametrize(
+    "limb, pose, rest, seed",
+    [
+        ("arm", {"right_shoulder": (0.785, 0.0, 0.0)}, 12, 5),
+        ("leg", {"right_hip": (0.6, 0.0, 0.0)}, 30, 6),
+    ],
+)
 def test_the_landmarks_rest_offset_is_measured_on_the_hanging_limb_and_removed(limb, pose, rest, seed, synth):
     # The limb hangs for `rest` frames (DESIGN.md's starting pose), then
     # points forward low for 20.  The world landmarks keep half of its depth

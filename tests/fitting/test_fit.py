@@ -40,9 +40,11 @@ def test_clean_keypoints_with_world_landmarks_are_fitted_closely(scene, synth):
     assert np.median(synth.limb_direction_errors(res.joints, truth)) < 1.0
     # The output is self-consistent: FK of the angles with the clip's offsets gives the joints.
     from capture2notation.fitting import PoseModel
+
     model = PoseModel(body, res.offsets)
-    np.testing.assert_allclose(model.forward(model.params(res.angles, res.root))[:, : len(JOINTS)],
-                               res.joints, atol=1e-9)
+    np.testing.assert_allclose(
+        model.forward(model.params(res.angles, res.root))[:, : len(JOINTS)], res.joints, atol=1e-9
+    )
     assert np.all(res.confidence[:, joint_index("right_wrist")] > 0.8)
 
 
@@ -113,7 +115,10 @@ def test_unknown_camera_uses_the_default_and_sets_the_floor(synth):
     cam = Camera.default((640, 480), hfov_deg=55.0)
     xy, conf, world, truth = synth.observe(ang, root, cam, body, noise_px=1.0)
     res = fit_keypoints(xy, conf, 25.0, world=world, image_size=(640, 480))
-    rel = lambda j: j - j[:, :1]
+
+    def rel(j):
+        return j - j[:, :1]
+
     assert _mpjpe(rel(res.joints), rel(truth)) < 0.04
     feet = [joint_index(f"{s}_{j}") for s in ("right", "left") for j in ("ankle", "toe")]
     assert np.max(np.abs(res.joints[:, feet, 2] - truth[:, feet, 2])) < 0.02
@@ -127,8 +132,15 @@ def test_fit_track_reads_a_keypoint_track(scene, synth):
     xyz = np.concatenate([xy, np.zeros((10, 33, 1))], axis=-1)
     presence = np.ones(10)
     presence[4] = 0.0  # no person found in frame 4
-    track = SimpleNamespace(xy=xyz, visibility=conf, presence=presence, world=world, fps=25.0,
-                            times=np.arange(10) / 25.0, image_size=np.array([640, 480]))
+    track = SimpleNamespace(
+        xy=xyz,
+        visibility=conf,
+        presence=presence,
+        world=world,
+        fps=25.0,
+        times=np.arange(10) / 25.0,
+        image_size=np.array([640, 480]),
+    )
     res = fit_track(track, camera=cam)
     assert np.all(np.isnan(res.joints[4])) and np.all(res.confidence[4] == 0)
     ok = np.r_[0:4, 5:10]
@@ -217,12 +229,14 @@ def test_arms_lowered_from_overhead_to_the_side_keep_one_branch(synth):
     n = 50
     s = np.linspace(0.0, 1.0, n)[:, None]
     ang, root = synth.held_pose(n, body)
-    ang[:, joint_index("right_shoulder")] = np.radians(np.array([164.0, 0.0, -91.0]) * (1 - s)
-                                                       + np.array([90.0, -30.0, -90.0]) * s)
+    ang[:, joint_index("right_shoulder")] = np.radians(
+        np.array([164.0, 0.0, -91.0]) * (1 - s) + np.array([90.0, -30.0, -90.0]) * s
+    )
     ang[:, joint_index("left_shoulder")] = ang[:, joint_index("right_shoulder")] * [1.0, -1.0, -1.0]
     # Slightly bent at the top, straight from a third of the way down.
     ang[:, joint_index("right_elbow"), 0] = ang[:, joint_index("left_elbow"), 0] = np.radians(
-        np.clip(20.0 - 60.0 * s[:, 0], 0.0, None))
+        np.clip(20.0 - 60.0 * s[:, 0], 0.0, None)
+    )
     ang = body.clip(ang)
     cam = Camera.default((640, 480))
     xy, conf, world, truth = synth.observe(ang, root, cam, body)

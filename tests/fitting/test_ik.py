@@ -32,7 +32,9 @@ def test_one_triple_in_limits_matches_the_vectorised_choice(e, joint):
 def test_the_swing_points_the_segment_at_u_and_stays_a_rotation(e, f):
     u = -euler_to_matrix(np.array(f))[:, 2]
     R = np.array(_swing_from(_rotation_1(e), u.tolist()))
-    np.testing.assert_allclose(-R[:, 2], u, atol=1e-9)
+    # Nearly parallel directions give the swing's axis from a cross product
+    # of norm ~1e-8: double precision leaves about sqrt(eps) ~ 1e-8 of error.
+    np.testing.assert_allclose(-R[:, 2], u, atol=1e-7)
     np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-9)
 
 

@@ -25,15 +25,16 @@ def test_lengths_of_a_scaled_figure_are_recovered(scale):
 
 
 def test_unmeasured_segments_take_the_median_ratio_and_sides_are_averaged():
-    body, pts = _points(1.1)
+    _body, pts = _points(1.1)
     conf = np.ones(pts.shape[:2])
     conf[:, joint_index("waist")] = 0.0  # pelvis->waist and waist->chest unmeasured
     pts = pts.copy()
     w, tip = joint_index("left_wrist"), joint_index("left_hand_tip")
     pts[:, tip] = pts[:, w] + 1.1 * (pts[:, tip] - pts[:, w])  # left hand 10 % longer
     off = estimate_offsets(pts, conf, Body())
-    np.testing.assert_allclose(np.linalg.norm(off[joint_index("waist")]),
-                               1.1 * np.linalg.norm(Body().offsets[joint_index("waist")]), rtol=1e-9)
+    np.testing.assert_allclose(
+        np.linalg.norm(off[joint_index("waist")]), 1.1 * np.linalg.norm(Body().offsets[joint_index("waist")]), rtol=1e-9
+    )
     base = np.linalg.norm(Body().offsets[tip])
     for name in ("right_hand_tip", "left_hand_tip"):
         assert np.linalg.norm(off[joint_index(name)]) == pytest.approx(1.1 * 1.05 * base, rel=1e-9)

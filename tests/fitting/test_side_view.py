@@ -52,8 +52,9 @@ def test_an_arm_raised_at_the_camera_with_its_shoulders_hidden_points_at_the_cam
     # behind the body), as in the leg phrase's side view.
     body = Body()
     cam = _side_camera(body)
-    xy, conf, world, truth = _observe(synth, body, cam, hidden=(11, 12),
-                                      right_shoulder=(0.0, -1.45, 0.0), right_elbow=(0.2, 0.0, 0.0))
+    xy, conf, world, truth = _observe(
+        synth, body, cam, hidden=(11, 12), right_shoulder=(0.0, -1.45, 0.0), right_elbow=(0.2, 0.0, 0.0)
+    )
     upper_t = truth[:, joint_index("right_elbow")] - truth[:, joint_index("right_shoulder")]
     assert np.all(upper_t[:, 0] > 0.2)  # towards the camera
     res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
@@ -69,8 +70,7 @@ def test_hidden_hips_face_where_the_shoulders_face(synth):
     # only the near shoulder and the legs say where the hips face.
     body = Body()
     cam = _side_camera(body)
-    xy, conf, world, truth = _observe(synth, body, cam, hidden=(11, 23, 24),
-                                      left_hip=(1.2, 0.0, 0.0))
+    xy, conf, world, truth = _observe(synth, body, cam, hidden=(11, 23, 24), left_hip=(1.2, 0.0, 0.0))
     res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
     fwd_t, fwd_f = body_frame(truth)[:, 1], body_frame(res.joints)[:, 1]
     err = _angle(fwd_f, fwd_t)

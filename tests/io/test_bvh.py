@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.errors import MotionFileError
+from capture2notation.fitting.motion import read_motion
 from capture2notation.io.bvh import (
     bvh_positions,
     canonical_name,
@@ -17,7 +18,6 @@ from capture2notation.io.bvh import (
     read_bvh_points,
     write_bvh,
 )
-from capture2notation.io.motion import read_motion
 
 FIXTURES = [("bvh/jesse_dance.bvh", 1007, 100.0), ("bvh/test_mocapbank.bvh", 455, 30.0)]
 
@@ -27,7 +27,7 @@ def test_fixtures_parse_with_their_frame_counts_and_rates(fixture_path, rel, fra
     skel = parse_bvh(fixture_path(rel))
     assert skel.motion.shape[0] == frames
     assert skel.fps == pytest.approx(fps, rel=1e-4)
-    points, conf, _, got_fps = read_bvh_points(fixture_path(rel))
+    points, conf, _, _got_fps = read_bvh_points(fixture_path(rel))
     assert points.shape == (frames, len(JOINTS), 3)
     # Every joint we need is found by name in both styles.
     for name in ("pelvis", "right_shoulder", "left_elbow", "right_wrist", "left_hip", "right_knee", "left_ankle"):
@@ -39,8 +39,14 @@ def test_fixtures_parse_with_their_frame_counts_and_rates(fixture_path, rel, fra
 
 
 def test_mixamo_and_bvh_python_shoulders_are_told_apart():
-    mixamo = ["mixamorig:Hips", "mixamorig:Spine", "mixamorig:LeftShoulder", "mixamorig:LeftArm",
-              "mixamorig:LeftForeArm", "mixamorig:LeftHand"]
+    mixamo = [
+        "mixamorig:Hips",
+        "mixamorig:Spine",
+        "mixamorig:LeftShoulder",
+        "mixamorig:LeftArm",
+        "mixamorig:LeftForeArm",
+        "mixamorig:LeftHand",
+    ]
     m = map_joints(mixamo)
     assert mixamo[m["left_shoulder"]] == "mixamorig:LeftArm"  # LeftShoulder is the collar
     assert mixamo[m["left_elbow"]] == "mixamorig:LeftForeArm"
@@ -50,8 +56,14 @@ def test_mixamo_and_bvh_python_shoulders_are_told_apart():
     assert other[m["left_hand_tip"]] == "LeftWrist_End"
     cmu = ["Hips", "LHipJoint", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "LowerBack", "Spine", "Spine1"]
     m = map_joints(cmu)
-    assert [cmu[m[j]] for j in ("left_hip", "left_knee", "left_ankle", "left_toe", "waist", "chest")] == \
-        ["LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "Spine", "Spine1"]
+    assert [cmu[m[j]] for j in ("left_hip", "left_knee", "left_ankle", "left_toe", "waist", "chest")] == [
+        "LeftUpLeg",
+        "LeftLeg",
+        "LeftFoot",
+        "LeftToeBase",
+        "Spine",
+        "Spine1",
+    ]
     assert canonical_name("mixamorig1:Left_Fore-Arm") == "leftforearm"
 
 
@@ -99,7 +111,7 @@ def test_written_file_is_y_up_with_our_rotation_order(tmp_path):
     fk = forward_kinematics(ang, root, body)
     np.testing.assert_allclose(pos[:, idx], np.stack([fk[..., 0], fk[..., 2], -fk[..., 1]], -1), atol=1e-5)
     # A generic reader (IK by name, not our angles) lands on the same joints.
-    points, conf, _, _ = read_bvh_points(path)
+    points, _conf, _, _ = read_bvh_points(path)
     np.testing.assert_allclose(points, fk, atol=1e-5)
 
 
@@ -132,10 +144,14 @@ def test_channel_order_composes_left_to_right(tmp_path_factory, order, angles):
     [
         ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 zero 0\n", ":4: expected a number for OFFSET of Hips"),
         ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Wrotation\n}\n", ":5: unknown channel"),
-        ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 3\nFrame Time: 0.1\n1 2\n",
-         "2 values, expected 3 frames"),
-        ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\nx\n",
-         ":10: expected a channel value"),
+        (
+            "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 3\nFrame Time: 0.1\n1 2\n",
+            "2 values, expected 3 frames",
+        ),
+        (
+            "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\nx\n",
+            ":10: expected a channel value",
+        ),
         ("MOTION\n", ":1: expected 'HIERARCHY'"),
     ],
 )
@@ -147,8 +163,10 @@ def test_malformed_files_name_the_line(tmp_path, text, message):
 
 
 def test_file_without_needed_joints_asks_for_a_map(tmp_path):
-    text = ("HIERARCHY\nROOT Blob\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n  OFFSET 0 1 0\n }\n}\n"
-            "MOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n")
+    text = (
+        "HIERARCHY\nROOT Blob\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n  OFFSET 0 1 0\n }\n}\n"
+        "MOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n"
+    )
     path = tmp_path / "blob.bvh"
     path.write_text(text)
     with pytest.raises(MotionFileError, match="joint_map"):

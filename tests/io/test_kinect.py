@@ -10,15 +10,15 @@ from hypothesis import strategies as st
 from capture2notation.body import JOINTS, Body, joint_index
 from capture2notation.errors import MotionFileError
 from capture2notation.fitting import PoseModel
+from capture2notation.fitting.motion import read_motion
 from capture2notation.io.kinect import (
     KINECT_JOINTS,
     KINECT_TO_JOINT,
     camera_to_world,
     read_kinect_csv,
+    world_to_camera,
     write_kinect_csv,
 )
-from capture2notation.io.kinect import world_to_camera
-from capture2notation.io.motion import read_motion
 
 # The performer stands 2.5 m in front of a sensor 0.8 m above the floor.
 _SENSOR = np.array([0.0, 2.5, 0.8])
@@ -61,8 +61,9 @@ def test_joint_order_is_the_kinect_sdk_order():
 
 def test_camera_axes_map_to_ours():
     # Sensor-left (+x) is the facing performer's right (+x); up is up; away from the sensor is -y.
-    np.testing.assert_allclose(camera_to_world(np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])),
-                               [[1, 0, 0], [0, 0, 1], [0, -1, 0]])
+    np.testing.assert_allclose(
+        camera_to_world(np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])), [[1, 0, 0], [0, 0, 1], [0, -1, 0]]
+    )
     p = np.random.default_rng(0).normal(size=(4, 3))
     np.testing.assert_allclose(world_to_camera(camera_to_world(p)), p)
 
@@ -78,8 +79,13 @@ def test_csv_of_a_known_pose_reads_back_as_that_pose(tmp_path):
     m = read_motion(path)
     assert m.source == "kinect" and m.fps == pytest.approx(30.0, rel=1e-5)
     truth = pts[:, : len(JOINTS)]
-    limbs = [("right_shoulder", "right_elbow"), ("right_elbow", "right_wrist"), ("left_elbow", "left_wrist"),
-             ("right_hip", "right_knee"), ("left_knee", "left_ankle")]
+    limbs = [
+        ("right_shoulder", "right_elbow"),
+        ("right_elbow", "right_wrist"),
+        ("left_elbow", "left_wrist"),
+        ("right_hip", "right_knee"),
+        ("left_knee", "left_ankle"),
+    ]
     for a, b in limbs:
         u = truth[:, joint_index(b)] - truth[:, joint_index(a)]
         v = m.joints[:, joint_index(b)] - m.joints[:, joint_index(a)]
@@ -87,7 +93,9 @@ def test_csv_of_a_known_pose_reads_back_as_that_pose(tmp_path):
         assert np.degrees(np.arccos(np.clip(cos, -1, 1))).max() < 3.0, (a, b)
     # Floor at z = 0 and the performer at the origin facing +y.
     assert abs(m.joints[0, joint_index("pelvis"), 0]) < 0.01 and abs(m.joints[0, joint_index("pelvis"), 1]) < 0.01
-    np.testing.assert_allclose(m.joints[:, joint_index("right_ankle"), 2], truth[:, joint_index("right_ankle"), 2], atol=0.02)
+    np.testing.assert_allclose(
+        m.joints[:, joint_index("right_ankle"), 2], truth[:, joint_index("right_ankle"), 2], atol=0.02
+    )
     assert m.joints[0, joint_index("right_hip"), 0] > m.joints[0, joint_index("left_hip"), 0]
 
 
@@ -100,7 +108,7 @@ def test_tracking_states_and_dropped_frames(tmp_path):
     times = np.arange(10) / 30.0
     times[5:] += 2 / 30.0  # two frames dropped after the fifth
     path = write_kinect_csv(tmp_path / "gaps.csv", times, cam, states)
-    t, pos, conf, fps = read_kinect_csv(path)
+    _t, pos, conf, fps = read_kinect_csv(path)
     assert pos.shape == (12, 25, 3) and fps == pytest.approx(30.0, rel=1e-5)
     assert np.all(np.isnan(pos[5:7])) and np.all(conf[5:7] == 0)
     assert np.all(np.isnan(pos[:, KINECT_JOINTS.index("HandTipLeft")]))
@@ -138,7 +146,6 @@ def test_malformed_rows_name_the_line(tmp_path, line, message):
         read_kinect_csv(path)
 
 
-
 @settings(max_examples=25, deadline=None)
 @given(T=st.integers(1, 6), seed=st.integers(0, 2**31 - 1))
 def test_csv_round_trip_keeps_tracked_values(tmp_path_factory, T, seed):
@@ -146,7 +153,7 @@ def test_csv_round_trip_keeps_tracked_values(tmp_path_factory, T, seed):
     pos = rng.uniform(-2.0, 4.0, (T, 25, 3))
     states = rng.integers(0, 3, (T, 25))
     path = write_kinect_csv(tmp_path_factory.mktemp("k") / "r.csv", np.arange(T) / 30.0, pos, states)
-    t, got, conf, _ = read_kinect_csv(path)
+    _t, got, conf, _ = read_kinect_csv(path)
     assert got.shape == (T, 25, 3)
     tracked = states > 0
     np.testing.assert_allclose(got[tracked], pos[tracked], atol=1e-6)

@@ -104,5 +104,5 @@ def test_unreadable_file(tmp_path, content):
     path = tmp_path / "truth.npz"
     if content is not None:
         path.write_bytes(content)
-    with pytest.raises(MotionFileError, match="truth.npz"):
+    with pytest.raises(MotionFileError, match=r"truth\.npz"):
         read_truth(path)

@@ -93,7 +93,7 @@ def test_unreadable_inputs_raise(tmp_path):
         list(iter_frames(junk))
     empty = tmp_path / "empty"
     empty.mkdir()
-    with pytest.raises(VideoError, match="no .*png"):
+    with pytest.raises(VideoError, match=r"no .*png"):
         probe(empty)
 
 

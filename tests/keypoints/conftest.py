@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+
 @pytest.fixture(scope="session")
 def blazepose_session(pose_model_path):
     """One onnxruntime session shared by all model tests."""
@@ -12,12 +13,14 @@ def blazepose_session(pose_model_path):
 
     return make_session(pose_model_path, threads=2)
 
+
 @pytest.fixture
 def blazepose(blazepose_session):
     """A fresh tracker reusing the shared session."""
     from capture2notation.keypoints.blazepose import BlazePose
 
     return BlazePose(session=blazepose_session)
+
 
 def _demo_pose(n_frames: int = 12, fps: float = 25.0):
     """Arms raise (one sideways, one forward), elbows bend, one leg lifts.
@@ -29,8 +32,8 @@ def _demo_pose(n_frames: int = 12, fps: float = 25.0):
 
     from capture2notation.body import JOINTS, Body
     from capture2notation.body.skeleton import joint_index
+    from synthetic.render import scene
 
-    scene = pytest.importorskip("synthetic.render.scene")
     a = np.zeros((n_frames, len(JOINTS), 3))
     s = np.linspace(0.0, 1.0, n_frames)
     a[:, joint_index("right_shoulder"), 1] = -1.2 * s
@@ -43,6 +46,7 @@ def _demo_pose(n_frames: int = 12, fps: float = 25.0):
     root = np.zeros((n_frames, 3))
     root[:, 2] = Body().rest[0, 2]
     return scene.Pose(a, root, Body(), fps)
+
 
 @pytest.fixture
 def demo_pose():

@@ -65,7 +65,10 @@ def test_tracking_follows_a_moving_person(fixture_path, blazepose):
     """Shift the photo 12 px per frame: the tracked crop must follow it."""
     image = cv2.imread(str(fixture_path("mediapipe/pose.jpg")))
     shifts = np.arange(6) * 12.0
-    frames = [cv2.warpAffine(image, np.float32([[1, 0, s], [0, 1, 0]]), image.shape[1::-1], borderMode=cv2.BORDER_REPLICATE) for s in shifts]
+    frames = [
+        cv2.warpAffine(image, np.float32([[1, 0, s], [0, 1, 0]]), image.shape[1::-1], borderMode=cv2.BORDER_REPLICATE)
+        for s in shifts
+    ]
     track = extract_frames(frames, fps=30.0, estimator=blazepose, smooth=False)
     hips = track.xy[:, 23:25, 0].mean(axis=1)
     np.testing.assert_allclose(hips - hips[0], shifts, atol=6.0)

@@ -48,7 +48,9 @@ def test_keypoints_command_markers_backend_on_image_folder(tmp_path):
         cv2.circle(img, (20 + 10 * i, 30), 5, (0, 200, 0), -1)
         cv2.imwrite(str(folder / f"{i:02d}.png"), img)
     out = tmp_path / "m.npz"
-    spec_free = CliRunner().invoke(main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--fps", "12"])
+    spec_free = CliRunner().invoke(
+        main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--fps", "12"]
+    )
     # The default marker set is the renderer's (green = hue 60 is its left shoulder).
     assert spec_free.exit_code == 0, spec_free.output
     track = KeypointTrack.load(out)
@@ -93,11 +95,15 @@ def test_markers_from_a_json_file(tmp_path):
         ' {"landmark": 15, "hsv_low": [110, 80, 60], "hsv_high": [130, 255, 255]}]'
     )
     out = tmp_path / "g.npz"
-    result = CliRunner().invoke(main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--markers", str(spec)])
+    result = CliRunner().invoke(
+        main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--markers", str(spec)]
+    )
     assert result.exit_code == 0, result.output
     track = KeypointTrack.load(out)
     np.testing.assert_allclose(track.xy[:, 16, :2], [[20, 20], [20, 30]], atol=0.5)
     np.testing.assert_allclose(track.xy[:, 15, :2], [[60, 30], [60, 30]], atol=0.5)
     spec.write_text('[{"landmark": "left_wirst", "bgr": [0, 0, 220]}]')
-    bad = CliRunner().invoke(main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--markers", str(spec)])
+    bad = CliRunner().invoke(
+        main, ["keypoints", str(folder), "-o", str(out), "--backend", "markers", "--markers", str(spec)]
+    )
     assert bad.exit_code == 2 and "marker entry 0" in bad.output and "left_wirst" in bad.output

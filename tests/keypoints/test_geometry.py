@@ -16,9 +16,9 @@ from capture2notation.keypoints.blazepose import (
     full_frame_crop,
 )
 
-crops = st.tuples(
-    st.floats(-200, 1200), st.floats(-200, 900), st.floats(20, 2000), st.floats(-np.pi, np.pi)
-).map(lambda c: np.array([c[0], c[1], c[2], c[2], c[3]]))
+crops = st.tuples(st.floats(-200, 1200), st.floats(-200, 900), st.floats(20, 2000), st.floats(-np.pi, np.pi)).map(
+    lambda c: np.array([c[0], c[1], c[2], c[2], c[3]])
+)
 
 
 def test_upright_person_has_zero_rotation_and_margin():

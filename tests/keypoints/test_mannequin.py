@@ -51,23 +51,31 @@ def _evaluate(blazepose, poses, view, flip_test):
         for j, frames in left_right_swaps(track.xy, truth["keypoints"], radius).items():
             swaps[j] += int(frames.sum())
     pck = {k: float(np.mean(v)) if v else float("nan") for k, v in hits.items()}
-    print(f"\n{view} (flip test {flip_test}): PCK@5% " + " ".join(f"{k}={v:.3f}" for k, v in pck.items()) + f"; swaps {swaps}")
+    print(
+        f"\n{view} (flip test {flip_test}): PCK@5% "
+        + " ".join(f"{k}={v:.3f}" for k, v in pck.items())
+        + f"; swaps {swaps}"
+    )
     return pck, swaps
 
 
 @pytest.fixture(scope="module")
 def results(blazepose_session):
-    render = pytest.importorskip("synthetic.render")
-    phrases = pytest.importorskip("synthetic.phrases")
     from capture2notation.body import Body
     from capture2notation.keypoints.blazepose import BlazePose
+    from synthetic import phrases, render
     from synthetic.interpret import interpret
 
-    poses = [render.Pose.from_motion(interpret(score, FPS, Body())) for _, score in sorted(phrases.builtin_phrases().items())]
+    poses = [
+        render.Pose.from_motion(interpret(score, FPS, Body())) for _, score in sorted(phrases.builtin_phrases().items())
+    ]
     bp = BlazePose(session=blazepose_session)
-    return {(view, flip): _evaluate(bp, poses, view, flip) for view in ("front", "45", "side") for flip in (False, True)}
+    return {
+        (view, flip): _evaluate(bp, poses, view, flip) for view in ("front", "45", "side") for flip in (False, True)
+    }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("view", ["front", "45", "side"])
 def test_one_pass_per_frame_finds_every_joint_without_swaps(results, view):
     """The default path: a floor (measured >= 0.89) and no left/right swaps."""
@@ -77,6 +85,7 @@ def test_one_pass_per_frame_finds_every_joint_without_swaps(results, view):
     assert sum(swaps.values()) == 0, f"{view}: left/right swaps {swaps}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("view", ["front", "45", "side"])
 def test_issue_target_pck95_and_no_swaps(results, view):
     """The issue's target, met with the flip test."""

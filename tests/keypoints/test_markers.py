@@ -89,7 +89,8 @@ def test_bad_specs_are_rejected():
 
 
 def _marker_render_case(demo_pose, view, n_frames=10):
-    render = pytest.importorskip("synthetic.render")
+    from synthetic import render
+
     pose = demo_pose(n_frames)
     cam = render.Camera.for_view(view, (640, 480), pose.body.height)
     truth = render.truth_fields(pose, cam)

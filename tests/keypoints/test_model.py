@@ -177,7 +177,7 @@ def test_session_rejects_a_model_that_is_not_blazepose(tmp_path):
     with pytest.raises(ModelError, match=r"other\.onnx: not the BlazePose"):
         make_session(path)
     (tmp_path / "junk.onnx").write_bytes(b"junk")
-    with pytest.raises(ModelError, match="junk.onnx"):
+    with pytest.raises(ModelError, match=r"junk\.onnx"):
         make_session(tmp_path / "junk.onnx")
 
 

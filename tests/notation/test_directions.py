@@ -74,7 +74,7 @@ angles = st.tuples(st.floats(-179.9, 180.0), st.floats(-89.9, 89.9))
 
 
 def _off_boundaries(az: float, el: float) -> bool:
-    near_sector = min(abs(((az - 22.5) % 45.0)), 45.0 - abs(((az - 22.5) % 45.0))) < 1e-6
+    near_sector = min(abs((az - 22.5) % 45.0), 45.0 - abs((az - 22.5) % 45.0)) < 1e-6
     near_level = min(abs(abs(el) - 22.5), abs(abs(el) - 67.5)) < 1e-6
     return not (near_sector or near_level)
 

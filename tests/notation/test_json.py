@@ -39,15 +39,25 @@ def test_dict_layout():
     d = score_to_dict(lab.loads(FIGURE))
     assert d["tempo"] == 64 and d["meter"] == 4 and d["emotion"] is None
     assert d["effort"] == {"time": -2.42, "weight": 0.6, "space": 0.0}
-    assert d["symbols"][2] == {"start": "1", "duration": "1/2", "part": "right_arm",
-                               "direction": "right", "level": "high", "bend": 0}
+    assert d["symbols"][2] == {
+        "start": "1",
+        "duration": "1/2",
+        "part": "right_arm",
+        "direction": "right",
+        "level": "high",
+        "bend": 0,
+    }
     half = score_to_dict(lab.loads("tempo: 129/2\n"))
     assert half["tempo"] == "129/2"
 
 
 def test_lenient_numbers_are_exact():
-    s = score_from_dict({"tempo": 60.5, "symbols": [
-        {"start": 0.25, "duration": "3/2", "part": "head", "direction": "forward", "level": "high"}]})
+    s = score_from_dict(
+        {
+            "tempo": 60.5,
+            "symbols": [{"start": 0.25, "duration": "3/2", "part": "head", "direction": "forward", "level": "high"}],
+        }
+    )
     assert s.tempo == Fraction(121, 2)
     assert s.symbols[0].start == Fraction(1, 4) and s.symbols[0].bend == 0
 
@@ -68,8 +78,11 @@ def _sym(**over):
 @pytest.mark.parametrize(
     "data,where,fragment",
     [
-        ({"symbols": [_sym(), _sym(start="2"), _sym(start="3"), _sym(start="4", direction="fwd")]},
-         "symbols[3].direction", "unknown direction 'fwd'"),
+        (
+            {"symbols": [_sym(), _sym(start="2"), _sym(start="3"), _sym(start="4", direction="fwd")]},
+            "symbols[3].direction",
+            "unknown direction 'fwd'",
+        ),
         ({"symbols": [_sym(part="tail")]}, "symbols[0].part", "unknown part 'tail'"),
         ({"symbols": [_sym(level=3)]}, "symbols[0].level", "expected a string"),
         ({"symbols": [_sym(start="x")]}, "symbols[0].start", "'x'"),
@@ -106,17 +119,28 @@ def test_invalid_json_names_the_line():
 
 
 _json_values = st.recursive(
-    st.none() | st.booleans() | st.integers(-5, 5) | st.floats(allow_nan=False) | st.text(max_size=5)
+    st.none()
+    | st.booleans()
+    | st.integers(-5, 5)
+    | st.floats(allow_nan=False)
+    | st.text(max_size=5)
     | st.sampled_from(["1/2", "head", "forward", "high", "place", "happy"]),
-    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(
-        st.sampled_from(["start", "duration", "part", "direction", "level", "bend", "time", "x"]), inner, max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=3)
+        | st.dictionaries(
+            st.sampled_from(["start", "duration", "part", "direction", "level", "bend", "time", "x"]), inner, max_size=4
+        )
+    ),
     max_leaves=12,
 )
 
 
 @settings(max_examples=120, deadline=None)
-@given(st.dictionaries(st.sampled_from(["title", "tempo", "meter", "effort", "emotion", "symbols", "format"]),
-                       _json_values, max_size=6))
+@given(
+    st.dictionaries(
+        st.sampled_from(["title", "tempo", "meter", "effort", "emotion", "symbols", "format"]), _json_values, max_size=6
+    )
+)
 def test_any_dict_builds_or_raises_score_format_error(data):
     try:
         score = score_from_dict(data, "fuzz.json")

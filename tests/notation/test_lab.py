@@ -41,9 +41,17 @@ def test_design_example_reads_exactly():
     }
 
 
-@pytest.mark.parametrize("token,value", [("1/2", Fraction(1, 2)), (".50", Fraction(1, 2)),
-                                         ("1.5", Fraction(3, 2)), ("2", Fraction(2)),
-                                         ("0.125", Fraction(1, 8)), ("4/6", Fraction(2, 3))])
+@pytest.mark.parametrize(
+    "token,value",
+    [
+        ("1/2", Fraction(1, 2)),
+        (".50", Fraction(1, 2)),
+        ("1.5", Fraction(3, 2)),
+        ("2", Fraction(2)),
+        ("0.125", Fraction(1, 8)),
+        ("4/6", Fraction(2, 3)),
+    ],
+)
 def test_beats_are_exact_fractions(token, value):
     s = lab.loads(f"{token} {token} head forward high\n")
     assert s.symbols[0].start == value and s.symbols[0].duration == value
@@ -70,8 +78,12 @@ def test_title_keeps_hash_and_quoted_whitespace():
 def test_writer_is_canonical():
     text = lab.dumps(lab.loads(FIGURE))
     lines = text.splitlines()
-    assert lines[:4] == ["title: Third port de bras", "tempo: 64", "meter: 4",
-                         "effort: time=-2.42 weight=0.6 space=0.0"]
+    assert lines[:4] == [
+        "title: Third port de bras",
+        "tempo: 64",
+        "meter: 4",
+        "effort: time=-2.42 weight=0.6 space=0.0",
+    ]
     assert lines[4].startswith("#") and lines[4].split()[1:6] == ["start", "duration", "part", "direction", "level"]
     rows = [ln.split() for ln in lines[5:]]
     assert rows[0] == ["0", "1", "right_arm", "forward", "low", "bend=1"]
@@ -193,8 +205,13 @@ def test_registry_dispatch_and_registration(tmp_path, monkeypatch):
     assert set(registry.formats()) >= {"lab", "json", "wolofsky1974", "laban_editor"}
     # A new format is one explicit call; dumps/loads go through it.
     monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
-    registry.register_format("lab_upper", (".ulab",), lambda text, path: lab.loads(text.lower(), path),
-                             lambda score: lab.dumps(score).upper(), "shouting .lab")
+    registry.register_format(
+        "lab_upper",
+        (".ulab",),
+        lambda text, path: lab.loads(text.lower(), path),
+        lambda score: lab.dumps(score).upper(),
+        "shouting .lab",
+    )
     score = lab.loads(FIGURE)
     write(score, tmp_path / "s.ulab")
     assert (tmp_path / "s.ulab").read_text().startswith("TITLE: THIRD PORT DE BRAS")
@@ -203,9 +220,39 @@ def test_registry_dispatch_and_registration(tmp_path, monkeypatch):
 
 
 _LAB_WORDS = st.sampled_from(
-    ["title:", "tempo:", "meter:", "effort:", "emotion:", "happy", "time=-2", "weight=.5", "space=1",
-     "0", "1", "1/2", ".5", "-1", "1/0", "nan", "1e9", "right_arm", "support", "forward", "place",
-     "high", "middle", "low", "bend=2", "bend=", "#", '"', "\t", "\r", "x:"]
+    [
+        "title:",
+        "tempo:",
+        "meter:",
+        "effort:",
+        "emotion:",
+        "happy",
+        "time=-2",
+        "weight=.5",
+        "space=1",
+        "0",
+        "1",
+        "1/2",
+        ".5",
+        "-1",
+        "1/0",
+        "nan",
+        "1e9",
+        "right_arm",
+        "support",
+        "forward",
+        "place",
+        "high",
+        "middle",
+        "low",
+        "bend=2",
+        "bend=",
+        "#",
+        '"',
+        "\t",
+        "\r",
+        "x:",
+    ]
 )
 
 

@@ -16,8 +16,17 @@ from capture2notation.notation.formats import format_for, lab
 from capture2notation.notation.formats import laban_editor as le
 
 FIELDS = ["start time", "duration", "head", "right elbow", "right wrist", "left elbow", "left wrist", "rotation"]
-SUITE_DIRECTIONS = {"Forward", "Right Forward", "Right", "Right Backward", "Backward",
-                    "Left Backward", "Left", "Left Forward", "Place"}
+SUITE_DIRECTIONS = {
+    "Forward",
+    "Right Forward",
+    "Right",
+    "Right Backward",
+    "Backward",
+    "Left Backward",
+    "Left",
+    "Left Forward",
+    "Place",
+}
 
 PHRASE = lab.loads("""\
 title: port de bras
@@ -97,8 +106,13 @@ def _collapsed(positions: dict):
 def test_write_read_write_keeps_the_key_poses(score):
     text = le.dumps(score)
     back = le.loads(text, "x.json")
-    assert {s.part for s in back.symbols} <= {"head", "right_upper_arm", "right_forearm",
-                                              "left_upper_arm", "left_forearm"}
+    assert {s.part for s in back.symbols} <= {
+        "head",
+        "right_upper_arm",
+        "right_forearm",
+        "left_upper_arm",
+        "left_forearm",
+    }
     original = next(iter(json.loads(text).values()))
     again = next(iter(le.score_to_laban_editor(back).values()))
     # Read at tempo 60 (1 beat = 1000 ms), so the times come back exactly.
@@ -124,8 +138,10 @@ def test_front_door_picks_laban_editor_by_name(tmp_path):
     [
         (lambda p: p["Position1"].update({"head": ["Up", "High"]}), "Position1.head: unknown direction 'Up'"),
         (lambda p: p["Position1"].update({"left wrist": ["Left", "Mid"]}), "Position1.left wrist: unknown level 'Mid'"),
-        (lambda p: p["Position2"].update({"right elbow": "Left"}),
-         "Position2.right elbow: expected [Direction, Level]"),
+        (
+            lambda p: p["Position2"].update({"right elbow": "Left"}),
+            "Position2.right elbow: expected [Direction, Level]",
+        ),
         (lambda p: p["Position1"].update({"start time": ["soon"]}), "Position1.start time: expected [milliseconds]"),
         (lambda p: p["Position1"].pop("start time"), "Position1.start time: missing"),
         (lambda p: p["Position1"].update({"right wrist": ["Place", "Normal"]}), "place middle"),

@@ -16,8 +16,14 @@ from capture2notation.notation.model import as_fraction
 
 @pytest.mark.parametrize(
     "value,expected",
-    [(3, Fraction(3)), ("3/2", Fraction(3, 2)), (".5", Fraction(1, 2)), (" 1.25 ", Fraction(5, 4)),
-     (0.5, Fraction(1, 2)), (Fraction(7, 3), Fraction(7, 3))],
+    [
+        (3, Fraction(3)),
+        ("3/2", Fraction(3, 2)),
+        (".5", Fraction(1, 2)),
+        (" 1.25 ", Fraction(5, 4)),
+        (0.5, Fraction(1, 2)),
+        (Fraction(7, 3), Fraction(7, 3)),
+    ],
 )
 def test_as_fraction_is_exact(value, expected):
     got = as_fraction(value)
@@ -76,8 +82,14 @@ def test_frozen_and_hashable():
 def test_score_order_does_not_depend_on_input_order(score, rnd):
     shuffled = list(score.symbols)
     rnd.shuffle(shuffled)
-    again = Score(symbols=tuple(shuffled), title=score.title, tempo=score.tempo, meter=score.meter,
-                  effort=score.effort, emotion=score.emotion)
+    again = Score(
+        symbols=tuple(shuffled),
+        title=score.title,
+        tempo=score.tempo,
+        meter=score.meter,
+        effort=score.effort,
+        emotion=score.emotion,
+    )
     assert again == score
     keys = [s.sort_key() for s in score.symbols]
     assert keys == sorted(keys)
@@ -135,8 +147,16 @@ def test_effort_resolution_and_emotion_presets():
 
 @pytest.mark.parametrize(
     "kwargs",
-    [dict(time=-1.0), dict(time=-5.5), dict(weight=0.0), dict(weight=0.99), dict(space=-0.1),
-     dict(space=1.5), dict(time=float("nan")), dict(time="fast")],
+    [
+        dict(time=-1.0),
+        dict(time=-5.5),
+        dict(weight=0.0),
+        dict(weight=0.99),
+        dict(space=-0.1),
+        dict(space=1.5),
+        dict(time=float("nan")),
+        dict(time="fast"),
+    ],
 )
 def test_effort_working_ranges(kwargs):
     with pytest.raises(NotationError, match="effort"):

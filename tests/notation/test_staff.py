@@ -104,8 +104,9 @@ def test_levels_and_bend_marks(tmp_path):
             assert bend.text == "\u00d72"
 
 
-@pytest.mark.parametrize("direction,n_vertices", [("place", 4), ("forward", 6), ("back", 6),
-                                                  ("right_forward", 4), ("left_back", 4)])
+@pytest.mark.parametrize(
+    "direction,n_vertices", [("place", 4), ("forward", 6), ("back", 6), ("right_forward", 4), ("left_back", 4)]
+)
 def test_shapes_fill_their_box(direction, n_vertices):
     pts = symbol_outline(direction, 10.0, 200.0, 40.0, 100.0, "right")
     assert len(pts) == n_vertices
@@ -133,8 +134,7 @@ def test_bar_lines_follow_the_meter():
 
 
 def test_long_scores_continue_on_further_staves():
-    score = Score(symbols=(Symbol(0, 3, "head", "forward", "high"), Symbol(3, 6, "right_arm", "right", "low")),
-                  meter=2)
+    score = Score(symbols=(Symbol(0, 3, "head", "forward", "high"), Symbol(3, 6, "right_arm", "right", "low")), meter=2)
     one = staff_layout(score, beat_height=10.0, measures_per_staff=None)
     two = staff_layout(score, beat_height=10.0, measures_per_staff=2)  # 5 measures -> 3 staves
     assert two.height < one.height and two.width > one.width

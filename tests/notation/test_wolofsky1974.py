@@ -56,9 +56,16 @@ def test_front_door_and_read_only(tmp_path):
 
 @pytest.mark.parametrize(
     "code,direction,level",
-    [("F", "forward", "middle"), ("BH", "back", "high"), ("RDFL", "right_forward", "low"),
-     ("LDB", "left_back", "middle"), ("RS", "right", "middle"), ("PH", "place", "high"),
-     ("LDFM", "left_forward", "middle"), ("RDBH", "right_back", "high")],
+    [
+        ("F", "forward", "middle"),
+        ("BH", "back", "high"),
+        ("RDFL", "right_forward", "low"),
+        ("LDB", "left_back", "middle"),
+        ("RS", "right", "middle"),
+        ("PH", "place", "high"),
+        ("LDFM", "left_forward", "middle"),
+        ("RDBH", "right_back", "high"),
+    ],
 )
 def test_codes(code, direction, level):
     s = wolofsky1974.loads(f"1 0 WRA 1 {code}\n")
@@ -139,9 +146,37 @@ def test_generated_coded_input_parses_to_its_symbols(case):
 
 
 @settings(max_examples=120, deadline=None)
-@given(st.lists(st.lists(st.sampled_from(["0", "1", "2", "3", ".5", "1.00", "x", "WLL", "ANR", "WXX", "-",
-                                          "F", "LSM", "PH", "P", "RDBL", "Type", "#"]) | st.text(max_size=3),
-                         max_size=6).map(" ".join), max_size=6).map("\n".join))
+@given(
+    st.lists(
+        st.lists(
+            st.sampled_from(
+                [
+                    "0",
+                    "1",
+                    "2",
+                    "3",
+                    ".5",
+                    "1.00",
+                    "x",
+                    "WLL",
+                    "ANR",
+                    "WXX",
+                    "-",
+                    "F",
+                    "LSM",
+                    "PH",
+                    "P",
+                    "RDBL",
+                    "Type",
+                    "#",
+                ]
+            )
+            | st.text(max_size=3),
+            max_size=6,
+        ).map(" ".join),
+        max_size=6,
+    ).map("\n".join)
+)
 def test_any_text_parses_or_raises_score_format_error(text):
     try:
         wolofsky1974.loads(text, "fuzz.w74")

@@ -13,17 +13,17 @@ import pytest
 from click.testing import CliRunner
 
 from capture2notation.body import JOINTS, Body
+from capture2notation.compare.agreement import score_differences
 from capture2notation.errors import PipelineError
 from capture2notation.io.truth import write_truth
 from capture2notation.notation import read
 from capture2notation.notation.model import Score, Symbol
-from capture2notation.quantise.agreement import score_differences
 from capture2notation.quantise.labels import LABEL_PARTS
 from pipelines.capture import capture, input_kind
 from pipelines.cli import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "quantise"))
-from quantise_motions import arm_angles, build_motion  # noqa: E402
+from quantise_motions import arm_angles, build_motion
 
 TEMPO = 72
 MOVES = [
@@ -61,8 +61,17 @@ def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
     out = tmp_path / "out"
     res = capture(sidecar, out, tempo=TEMPO, progress=False, effort=False)
     assert res.kind == "truth" and res.score.tempo == TEMPO
-    for name in ("score.lab", "score.json", "laban_editor.json", "benesh.json", "labels.csv", "staff.svg",
-                 "staff.png", "capture.npz", "index.html"):
+    for name in (
+        "score.lab",
+        "score.json",
+        "laban_editor.json",
+        "benesh.json",
+        "labels.csv",
+        "staff.svg",
+        "staff.png",
+        "capture.npz",
+        "index.html",
+    ):
         assert (out / name).is_file(), name
     assert score_differences(EXPECTED, read(out / "score.lab")) == []
     assert score_differences(EXPECTED, read(out / "score.json")) == []
@@ -129,25 +138,36 @@ def test_bad_inputs_are_named(tmp_path):
 
 def test_rendered_video_through_markers_backend(tmp_path):
     """The video path: render (colour markers) → keypoints → fit → notation files and overlay."""
-    render = pytest.importorskip("synthetic.render")
     from capture2notation.notation.formats import loads
+    from synthetic import render
 
     score = loads("tempo: 90\n0 1 right_arm right middle\n1 1 right_arm place low\n", "lab")
     render.render_score(score, tmp_path / "r", fps=25, size=(320, 240), view="front", style="markers", progress=False)
-    res = capture(tmp_path / "r" / "video.mp4", tmp_path / "c", backend="markers", tempo=90, progress=False,
-                  effort=False)
+    res = capture(
+        tmp_path / "r" / "video.mp4", tmp_path / "c", backend="markers", tempo=90, progress=False, effort=False
+    )
     assert res.kind == "video" and res.track is not None
     assert (tmp_path / "c" / "overlay.mp4").stat().st_size > 0
     with np.load(tmp_path / "c" / "capture.npz") as z:
         assert z["keypoints"].shape == (res.n_frames, 33, 3)
-        assert np.isfinite(z["keypoints"][:, 16, :2]).all(axis=1).mean() > 0.9  # right wrist marker seen (no depth from markers)
+        assert (
+            np.isfinite(z["keypoints"][:, 16, :2]).all(axis=1).mean() > 0.9
+        )  # right wrist marker seen (no depth from markers)
     # The sidecar's camera was used for the fit; the arm's raise is found at the right time.
     arm = [s for s in res.score.symbols if s.part == "right_arm"]
     assert arm and arm[0].start == 0 and arm[0].level == "middle"
     assert 'src="overlay.mp4"' in (tmp_path / "c" / "index.html").read_text()
 
 
-@pytest.mark.parametrize("rel", ["bvh/test_mocapbank.bvh", "bvh/jesse_dance.bvh"])
+@pytest.mark.parametrize(
+    "rel",
+    [
+        "bvh/test_mocapbank.bvh",
+        # The reader's floor misses this file's standing feet (issue 13): the
+        # quantiser says so and writes no supports.
+        pytest.param("bvh/jesse_dance.bvh", marks=pytest.mark.filterwarnings("ignore:feet on the floor in only")),
+    ],
+)
 def test_bvh_fixtures_give_a_score_and_a_staff(fixture_path, rel, tmp_path):
     res = capture(fixture_path(rel), tmp_path / "o", tempo=120, progress=False, effort=False)
     assert res.kind == "bvh" and len(res.score.symbols) >= 3
@@ -163,9 +183,9 @@ def test_a_kinect_recording_of_the_port_de_bras_gives_its_score(tmp_path):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "io"))
     from test_kinect import _kinect_rows
 
+    from capture2notation.compare.agreement import compare_scores
     from capture2notation.fitting import PoseModel
     from capture2notation.io.kinect import write_kinect_csv
-    from capture2notation.quantise.agreement import compare_scores
     from synthetic.interpret import interpret
     from synthetic.phrases import phrase
 
@@ -174,7 +194,9 @@ def test_a_kinect_recording_of_the_port_de_bras_gives_its_score(tmp_path):
     model = PoseModel(motion.body)
     pts = model.forward(model.params(motion.angles, motion.root))
     T = pts.shape[0]
-    csv_path = write_kinect_csv(tmp_path / "take.csv", np.arange(T) / 30.0, _kinect_rows(model, pts), np.full((T, 25), 2))
+    csv_path = write_kinect_csv(
+        tmp_path / "take.csv", np.arange(T) / 30.0, _kinect_rows(model, pts), np.full((T, 25), 2)
+    )
     res = capture(csv_path, tmp_path / "o", tempo=score.tempo, progress=False, effort=False)
     assert res.kind == "kinect" and (tmp_path / "o" / "staff.svg").exists()
     a = compare_scores(score, res.score)

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from capture2notation.compare.agreement import agreement_cells
 from capture2notation.io.truth import read_truth
 from capture2notation.notation.formats import read
-from capture2notation.quantise.agreement import agreement_cells
 from pipelines.cli import main
 from pipelines.commands import demo as demo_mod
 from synthetic.phrases import builtin_phrases
@@ -21,6 +21,7 @@ def _links(page: Path) -> list[str]:
     return re.findall(r'(?:href|src)="([^"#]+)"', page.read_text(encoding="utf-8"))
 
 
+@pytest.mark.slow
 @pytest.mark.model
 def test_demo_closes_the_loop_on_the_port_de_bras(tmp_path, pose_model_path):
     (res,) = demo_mod.run_demo(tmp_path, phrases=("port_de_bras",), effort=False, progress=False)
@@ -48,8 +49,10 @@ def test_demo_command_prints_the_figures_and_where_files_are(tmp_path, monkeypat
 
     def fake_run(outdir, **kw):  # the loop itself is tested above; here the command's wiring
         calls.update(kw, outdir=outdir)
-        return [demo_mod.DemoResult(p, Path(outdir) / p, (3, 4), 0.75, 0.25, (64.0, 64.0), 4.5, 120.0, {})
-                for p in kw["phrases"]]
+        return [
+            demo_mod.DemoResult(p, Path(outdir) / p, (3, 4), 0.75, 0.25, (64.0, 64.0), 4.5, 120.0, {})
+            for p in kw["phrases"]
+        ]
 
     monkeypatch.setattr(demo_mod, "run_demo", fake_run)
     res = CliRunner().invoke(main, ["demo", "-o", str(tmp_path), "--phrase", "all", "--size", "80x60", "--no-effort"])
@@ -63,8 +66,10 @@ def test_demo_command_prints_the_figures_and_where_files_are(tmp_path, monkeypat
 
 def test_demo_page_lists_where_each_capture_differs(tmp_path):
     diff = (("right_arm", 4.0, "right_forward low", "right low"),)
-    results = [demo_mod.DemoResult("a", tmp_path / "a", (3, 3), 0.9, 0.0, (64.0, 64.0), 4.5, 120.0, {}, diff),
-               demo_mod.DemoResult("b", tmp_path / "b", (3, 3), 1.0, 0.0, (64.0, 64.0), 4.5, 120.0, {})]
+    results = [
+        demo_mod.DemoResult("a", tmp_path / "a", (3, 3), 0.9, 0.0, (64.0, 64.0), 4.5, 120.0, {}, diff),
+        demo_mod.DemoResult("b", tmp_path / "b", (3, 3), 1.0, 0.0, (64.0, 64.0), 4.5, 120.0, {}),
+    ]
     page = demo_mod.index_html(results)
     assert "<h2>a: where the capture differs</h2>" in page
     assert "<td>right_arm</td><td>4</td><td>right_forward low</td><td>right low</td>" in page

@@ -1,6 +1,5 @@
 """The fidelity study: configuration, grid, one job, determinism, resuming, Dask."""
 
-
 import numpy as np
 import pytest
 
@@ -17,12 +16,19 @@ from pipelines.fidelity.config import StudyConfig, load_config, quick
 from pipelines.fidelity.measure import builtin_scores, kept_frames, perform
 from pipelines.fidelity.runner import run_condition, run_study
 
-synthetic = pytest.importorskip("synthetic.interpret", reason="the virtual dancer is needed to perform phrases")
-
 TINY = dict(
-    phrases=("figure7",), emotions=("happy", "sad"), takes=2, training_takes=2, capture="truth",
-    frame_rates=(25, 5), resampling=("keyframe",), image_sizes=((320, 240),), views=("front",),
-    compression=(0,), noise=(0.0,), bootstrap=3,
+    phrases=("figure7",),
+    emotions=("happy", "sad"),
+    takes=2,
+    training_takes=2,
+    capture="truth",
+    frame_rates=(25, 5),
+    resampling=("keyframe",),
+    image_sizes=((320, 240),),
+    views=("front",),
+    compression=(0,),
+    noise=(0.0,),
+    bootstrap=3,
     baseline={"frame_rate": 25, "image_size": (320, 240), "view": "front", "compression": 0, "noise": 0.0},
 )
 
@@ -34,7 +40,7 @@ def test_config_from_toml_and_errors(tmp_path):
     assert cfg.seed == 7 and cfg.frame_rates == (25, 8.33) and cfg.image_sizes == ((220, 175),)
     assert cfg.baseline["view"] == "side" and cfg.baseline["image_size"] == (640, 480)
     p.write_text("sede = 7\n")
-    with pytest.raises(PipelineError, match="unknown setting.*sede"):
+    with pytest.raises(PipelineError, match=r"unknown setting.*sede"):
         load_config(p)
     p.write_text("seed = [\n")
     with pytest.raises(PipelineError, match="not valid TOML"):
@@ -50,8 +56,15 @@ def test_default_grid_one_factor_at_a_time():
     assert conds[0].factor == "baseline"
     assert len({c.params() for c in conds}) == len(conds)  # no duplicate recordings
     rates = {(c.frame_rate, c.resampling) for c in conds if c.factor in ("frame_rate", "baseline")}
-    assert rates == {("25", "keyframe"), ("25/2", "keyframe"), ("25/2", "naive"), ("25/3", "keyframe"),
-                     ("25/3", "naive"), ("5", "keyframe"), ("5", "naive")}
+    assert rates == {
+        ("25", "keyframe"),
+        ("25/2", "keyframe"),
+        ("25/2", "naive"),
+        ("25/3", "keyframe"),
+        ("25/3", "naive"),
+        ("5", "keyframe"),
+        ("5", "naive"),
+    }
     # 1 baseline + 6 reduced rates + 3 other sizes + 2 other views + 2 compressions + 2 noises
     assert len(conds) == 16
     q = build_conditions(quick(StudyConfig(), ("a", "b", "c")))
@@ -132,6 +145,7 @@ def test_same_seed_same_results_and_resume(tmp_path):
     assert r0["tempo_true"] != r1["tempo_true"] and r0["mpjpe_mm"] != r1["mpjpe_mm"]
 
 
+@pytest.mark.slow
 def test_dask_cluster_gives_the_same_results(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     cfg = StudyConfig(**{**TINY, "emotions": ("happy", "angry"), "frame_rates": (25,)})
@@ -149,8 +163,17 @@ def test_unreachable_scheduler_is_a_one_line_error(tmp_path):
 
 
 def _line(factor, condition, accuracy, percent, trials=72):
-    return {"factor": factor, "condition": condition, "jobs": 6, "failed": 0, "symbol_accuracy": accuracy,
-            "angle_error_deg": 5.0, "timing_error_s": 0.05, "percent_correct": percent, "trials": trials}
+    return {
+        "factor": factor,
+        "condition": condition,
+        "jobs": 6,
+        "failed": 0,
+        "symbol_accuracy": accuracy,
+        "angle_error_deg": 5.0,
+        "timing_error_s": 0.05,
+        "percent_correct": percent,
+        "trials": trials,
+    }
 
 
 def test_conclusions_judge_the_observer_against_the_experts_with_a_binomial_test():

@@ -44,8 +44,22 @@ def score_file(tmp_path):
 def test_render_writes_video_truth_and_score(tmp_path, score_file):
     out = tmp_path / "out"
     res = CliRunner().invoke(
-        main, ["render", str(score_file), "-o", str(out), "--fps", "10", "--size", "96x72", "--view", "side",
-               "--style", "markers"])
+        main,
+        [
+            "render",
+            str(score_file),
+            "-o",
+            str(out),
+            "--fps",
+            "10",
+            "--size",
+            "96x72",
+            "--view",
+            "side",
+            "--style",
+            "markers",
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert sorted(p.name for p in out.iterdir()) == ["score.lab", "truth.npz", "video.mp4"]
     truth = read_truth(out / "truth.npz")
@@ -63,8 +77,23 @@ def test_render_writes_video_truth_and_score(tmp_path, score_file):
 
 def test_render_with_an_emotion_takes_its_tempo_and_effort(tmp_path, score_file):
     out = tmp_path / "sad"
-    res = CliRunner().invoke(main, ["render", str(score_file), "-o", str(out), "--fps", "5", "--size", "64x48",
-                                    "--style", "stick", "--emotion", "sad"])
+    res = CliRunner().invoke(
+        main,
+        [
+            "render",
+            str(score_file),
+            "-o",
+            str(out),
+            "--fps",
+            "5",
+            "--size",
+            "64x48",
+            "--style",
+            "stick",
+            "--emotion",
+            "sad",
+        ],
+    )
     assert res.exit_code == 0, res.output
     truth = read_truth(out / "truth.npz")
     # 2 beats at sad's 37 bpm = 3.24 s at 5 fps.
@@ -75,8 +104,9 @@ def test_render_with_an_emotion_takes_its_tempo_and_effort(tmp_path, score_file)
 
 def test_render_png_frames_match_the_truth(tmp_path, score_file):
     out = tmp_path / "png"
-    res = CliRunner().invoke(main, ["render", str(score_file), "-o", str(out), "--fps", "4", "--size", "64x48",
-                                    "--png"])
+    res = CliRunner().invoke(
+        main, ["render", str(score_file), "-o", str(out), "--fps", "4", "--size", "64x48", "--png"]
+    )
     assert res.exit_code == 0, res.output
     assert sorted(p.name for p in out.iterdir()) == ["frames", "score.lab", "truth.npz"]
     frames = sorted((out / "frames").iterdir())

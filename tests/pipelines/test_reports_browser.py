@@ -15,13 +15,15 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("synthetic.interpret", reason="the reports need the virtual dancer")
-
-from pipelines.fidelity import StudyConfig, run_fidelity_study  # noqa: E402
-from pipelines.score import run_score  # noqa: E402
+from pipelines.fidelity import StudyConfig, run_fidelity_study
+from pipelines.score import run_score
 
 CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
-pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (apt-get install -y chromium)")
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.browser,
+    pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (apt-get install -y chromium)"),
+]
 
 PROBE = """<script>
 window.addEventListener("load", () => {
@@ -39,16 +41,27 @@ def open_in_chromium(report: Path, tmp_path: Path) -> dict:
     probe = report.with_name("probe_" + report.name)
     probe.write_text(report.read_text(encoding="utf-8").replace("</body>", PROBE + "</body>"), encoding="utf-8")
     profile = tempfile.mkdtemp(dir=tmp_path)
-    common = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-              "--disable-background-networking", "--disable-component-update", "--disable-sync",
-              f"--user-data-dir={profile}", "--virtual-time-budget=10000"]
+    common = [
+        CHROMIUM,
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={profile}",
+        "--virtual-time-budget=10000",
+    ]
     dom = subprocess.run(common + ["--dump-dom", probe.as_uri()], capture_output=True, text=True, timeout=120)
     m = re.search(r'<pre id="c2n-probe">(.*?)</pre>', dom.stdout, re.S)
     assert m, f"probe did not run; chromium said: {dom.stderr[-500:]}"
     found = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
     shot = tmp_path / (report.stem + ".png")
-    subprocess.run(common + ["--window-size=1200,2400", f"--screenshot={shot}", report.as_uri()],
-                   capture_output=True, timeout=120)
+    subprocess.run(
+        common + ["--window-size=1200,2400", f"--screenshot={shot}", report.as_uri()], capture_output=True, timeout=120
+    )
     found["screenshot_bytes"] = shot.stat().st_size if shot.exists() else 0
     return found
 
@@ -74,14 +87,31 @@ def test_score_report_in_chromium(tmp_path):
 
 def test_fidelity_report_in_chromium(tmp_path):
     cfg = StudyConfig(
-        phrases=("figure7",), emotions=("happy", "sad"), takes=2, training_takes=2,
-        capture="truth", frame_rates=(25, 5), resampling=("naive",), image_sizes=((220, 175), (640, 480)), views=("front",),
-        compression=(0,), noise=(0.0,), bootstrap=3,
+        phrases=("figure7",),
+        emotions=("happy", "sad"),
+        takes=2,
+        training_takes=2,
+        capture="truth",
+        frame_rates=(25, 5),
+        resampling=("naive",),
+        image_sizes=((220, 175), (640, 480)),
+        views=("front",),
+        compression=(0,),
+        noise=(0.0,),
+        bootstrap=3,
     )
     run_fidelity_study(cfg, tmp_path / "study", workers=1, progress=False)
     found = open_in_chromium(tmp_path / "study" / "report.html", tmp_path)
-    check_all_images(found, {"plots/fig313_complexity.png", "plots/fig314_same_pairs.png",
-                             "plots/fig315_different_pairs.png", "plots/fig316_frame_rate.png",
-                             "plots/recovery_frame_rate.png", "plots/factor_image_size.png"})
+    check_all_images(
+        found,
+        {
+            "plots/fig313_complexity.png",
+            "plots/fig314_same_pairs.png",
+            "plots/fig315_different_pairs.png",
+            "plots/fig316_frame_rate.png",
+            "plots/recovery_frame_rate.png",
+            "plots/factor_image_size.png",
+        },
+    )
     html = (tmp_path / "study" / "report.html").read_text()
     assert "78.70" in html and "Conclusions" in html

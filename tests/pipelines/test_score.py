@@ -8,12 +8,10 @@ import pytest
 from click.testing import CliRunner
 
 from capture2notation.errors import PipelineError
-
-pytest.importorskip("synthetic.interpret", reason="the virtual dancer dances score files")
-from capture2notation.notation import formats  # noqa: E402
-from pipelines.cli import main  # noqa: E402
-from pipelines.score import compare_sides, load_side, run_score  # noqa: E402
-from synthetic.interpret import interpret  # noqa: E402
+from capture2notation.notation import formats
+from pipelines.cli import main
+from pipelines.score import compare_sides, load_side, run_score
+from synthetic.interpret import interpret
 
 PHRASE = """title: test phrase
 tempo: 60
@@ -97,7 +95,8 @@ def test_cli_score(lab, tmp_path):
 
 
 def test_truth_sidecar_against_its_score(lab, tmp_path):
-    job = pytest.importorskip("synthetic.render.job", reason="the renderer writes truth sidecars")
+    from synthetic.render import job
+
     out = job.render_score(formats.read(lab), tmp_path / "render", size=(96, 72), style="stick", progress=False)
     truth = load_side(out / "truth.npz")
     assert truth.kind == "truth" and truth.score is not None

@@ -9,7 +9,7 @@ import pytest
 
 # The helpers module sits beside this file (tests are not a package).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from quantise_motions import arm_angles, build_motion  # noqa: E402
+from quantise_motions import arm_angles, build_motion
 
 
 @pytest.fixture

@@ -12,8 +12,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from capture2notation.body import JOINTS, forward_kinematics, joint_index
-from capture2notation.effort.model import progress
 from capture2notation.notation.directions import canonical_vector
+from capture2notation.notation.effort import progress
 
 
 def arm_angles(direction: str, level: str) -> np.ndarray:

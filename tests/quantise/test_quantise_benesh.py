@@ -66,7 +66,13 @@ def test_extremities_on_the_stave():
 
 def test_bends_head_and_body():
     joints, angles = _poses(
-        {"right_elbow": (90, 0, 0), "left_knee": (-60, 0, 0), "neck": (-30, 0, 0), "waist": (0, 20, 0), "chest": (0, 0, 30)},
+        {
+            "right_elbow": (90, 0, 0),
+            "left_knee": (-60, 0, 0),
+            "neck": (-30, 0, 0),
+            "waist": (0, 20, 0),
+            "chest": (0, 0, 30),
+        },
     )
     _, (p,) = benesh_key_poses(joints, [0], fps=25, angles=angles)
     assert dict(p.bends) == {"right_elbow": 3, "left_knee": 2}

@@ -9,12 +9,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from quantise_motions import arm_angles
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.errors import QuantiseError
 from capture2notation.notation.model import DIRECTIONS, LEVELS
-from quantise_motions import arm_angles
-
 from capture2notation.quantise.labels import LABEL_PARTS, label_frames, labels_csv_text, write_labels_csv
 
 
@@ -127,10 +126,10 @@ def test_labels_csv_has_a_row_per_frame_and_part(tmp_path):
     rows = list(csv.DictReader(io.StringIO(path.read_text())))
     assert len(rows) == 3 * len(LABEL_PARTS)
     assert list(rows[0]) == ["frame", "time", "part", "direction", "level", "bend"]
-    r = [x for x in rows if x["frame"] == "2" and x["part"] == "right_arm"][0]
+    r = next(x for x in rows if x["frame"] == "2" and x["part"] == "right_arm")
     assert (r["direction"], r["level"], r["bend"]) == ("forward", "middle", "0")
     assert float(r["time"]) == pytest.approx(2 / 25)
-    h = [x for x in rows if x["frame"] == "0" and x["part"] == "head"][0]
+    h = next(x for x in rows if x["frame"] == "0" and x["part"] == "head")
     assert h["bend"] == ""
     assert labels_csv_text(lab) == path.read_text()
 

@@ -12,14 +12,13 @@ from fractions import Fraction as F
 
 import numpy as np
 import pytest
+from quantise_motions import arm_angles, build_motion
 from scipy.ndimage import gaussian_filter1d
 
 from capture2notation.body import JOINTS, forward_kinematics, joint_index
-from capture2notation.effort.model import progress
-from capture2notation.quantise.agreement import normalise
+from capture2notation.compare.agreement import normalise
+from capture2notation.notation.effort import progress
 from capture2notation.quantise.segment import segment_motion
-
-from quantise_motions import arm_angles, build_motion
 
 FPS = 25.0
 
@@ -130,12 +129,22 @@ def test_movements_chained_without_a_hold_part_at_the_written_pose_between_them(
         (3, 1, "left_shoulder", arm_angles("left", "low")),
         (4, 2, "left_shoulder", np.zeros(3)),
     ]
+    from capture2notation.compare.agreement import compare_scores
     from capture2notation.notation.model import Score, Symbol
-    from capture2notation.quantise.agreement import compare_scores
 
-    expected = Score(symbols=tuple(Symbol(s, d, "left_arm", *lab) for s, d, lab in (
-        (F(1, 2), F(1, 2), ("left", "middle")), (1, 1, ("forward", "high")), (F(5, 2), F(1, 2), ("left", "middle")),
-        (3, 1, ("left", "low")), (4, 2, ("place", "low")))), tempo=100)
+    expected = Score(
+        symbols=tuple(
+            Symbol(s, d, "left_arm", *lab)
+            for s, d, lab in (
+                (F(1, 2), F(1, 2), ("left", "middle")),
+                (1, 1, ("forward", "high")),
+                (F(5, 2), F(1, 2), ("left", "middle")),
+                (3, 1, ("left", "low")),
+                (4, 2, ("place", "low")),
+            )
+        ),
+        tempo=100,
+    )
     # A sustained Effort: its speed at each arrival stays high.
     joints, _ = build_motion(moves, 100, beats=8, b=-2.2, x0=0.5)
     agree = []
@@ -170,8 +179,8 @@ def test_fitted_steps_keep_their_direction_and_their_flight():
     read as a step the other way."""
     import warnings
 
+    from capture2notation.compare.agreement import compare_scores
     from capture2notation.notation.formats import loads
-    from capture2notation.quantise.agreement import compare_scores
     from synthetic.interpret import interpret
 
     score = loads(STEPS, "lab")
@@ -380,8 +389,11 @@ def test_a_rise_from_plie_to_releve_passes_through_middle_without_writing_it(see
     noisy = joints + _correlated(joints.shape, 0.004, seed)
     sup = _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)
     assert [(p, d, lv) for _, _, p, d, lv in sup] == [
-        ("support", "place", "low"), ("support", "place", "high"), ("support", "place", "low"),
-        ("support", "place", "middle")], sup
+        ("support", "place", "low"),
+        ("support", "place", "high"),
+        ("support", "place", "low"),
+        ("support", "place", "middle"),
+    ], sup
     assert all(abs(s - w) <= F(1, 2) for (s, *_), w in zip(sup, (0, 2, 4, 6))), sup
 
 
@@ -415,7 +427,11 @@ def test_a_gesturing_foot_brushing_the_floor_takes_no_weight(seed):
     for name in ("right_ankle", "right_toe"):
         k = joint_index(name)
         j[:, k] = (1 - w[:, None]) * j[:, k] + w[:, None] * rest[k]
-    upper = [k for k, n in enumerate(JOINTS) if not n.startswith(("right_", "left_hip", "left_knee", "left_ankle", "left_toe"))]
+    upper = [
+        k
+        for k, n in enumerate(JOINTS)
+        if not n.startswith(("right_", "left_hip", "left_knee", "left_ankle", "left_toe"))
+    ]
     j[:, upper, 0] += 0.15 * w[:, None]  # the fitted pelvis drifts over the right foot
     noisy = j + _correlated(j.shape, 0.003, seed)
     sup = _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)

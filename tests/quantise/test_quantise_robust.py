@@ -9,14 +9,13 @@ fit's correlated wobble and bias added; no BlazePose.
 from __future__ import annotations
 
 import numpy as np
+from quantise_motions import arm_angles, build_motion
 from scipy.ndimage import gaussian_filter1d
 
-from capture2notation.body import JOINTS, forward_kinematics, joint_index
-from capture2notation.quantise.agreement import normalise
+from capture2notation.body import JOINTS, joint_index
+from capture2notation.compare.agreement import normalise
 from capture2notation.quantise.measured import hold_frames, keep_previous
 from capture2notation.quantise.segment import segment_motion
-
-from quantise_motions import arm_angles, build_motion
 
 FPS = 25.0
 
@@ -40,8 +39,11 @@ def test_a_bend_just_past_its_band_keeps_the_previous_bend_degree():
     joints, _ = build_motion(moves, 72, beats=6)
     for seed in (0, 1):
         noisy = joints + _correlated(joints.shape, 0.004, seed)
-        arm = [(s.direction, s.level, s.bend) for s in normalise(segment_motion(noisy, FPS, tempo=72).score).symbols
-               if s.part == "right_arm"]
+        arm = [
+            (s.direction, s.level, s.bend)
+            for s in normalise(segment_motion(noisy, FPS, tempo=72).score).symbols
+            if s.part == "right_arm"
+        ]
         assert arm == [("right", "middle", 0), ("right", "low", 0)], arm
 
 

@@ -6,15 +6,14 @@ from fractions import Fraction as F
 
 import numpy as np
 import pytest
+from quantise_motions import arm_angles, build_motion
 
 from capture2notation.body import Body
+from capture2notation.compare.agreement import compare_scores, score_differences
 from capture2notation.errors import QuantiseError
 from capture2notation.notation.model import LEVELS, Score, Symbol
-from capture2notation.quantise.agreement import compare_scores, score_differences
 from capture2notation.quantise.segment import SegmentParams, segment, segment_motion
 from capture2notation.quantise.spans import movement_spans
-
-from quantise_motions import arm_angles, build_motion
 
 TEMPO = 64
 # An arm phrase: out to forward middle, up to forward high over half a beat,
@@ -62,7 +61,13 @@ def test_elbow_only_movement_is_a_forearm_symbol():
     joints, _ = build_motion(moves, 60)
     score = _gestures(segment(joints, 25.0, tempo=60))
     assert [(s.start, s.duration, s.part, s.direction, s.level) for s in score.symbols] == [
-        (1, 1, "right_arm", "forward", "middle", ),
+        (
+            1,
+            1,
+            "right_arm",
+            "forward",
+            "middle",
+        ),
         (3, 1, "right_forearm", "place", "high"),
     ]
 
@@ -188,9 +193,14 @@ def test_quick_measured_movement_that_holds_is_kept():
         (1, F(1, 2), "right_shoulder", arm_angles("forward", "middle")),
         (4, 1, "right_shoulder", np.zeros(3)),
     ]
-    expected = Score(symbols=(Symbol(0, 1, "right_arm", "right", "middle"),
-                              Symbol(1, F(1, 2), "right_arm", "forward", "middle"),
-                              Symbol(4, 1, "right_arm", "place", "low")), tempo=96)
+    expected = Score(
+        symbols=(
+            Symbol(0, 1, "right_arm", "right", "middle"),
+            Symbol(1, F(1, 2), "right_arm", "forward", "middle"),
+            Symbol(4, 1, "right_arm", "place", "low"),
+        ),
+        tempo=96,
+    )
     # A sudden Effort: the fitted reference logistic is quickest on it.
     joints, _ = build_motion(moves, 96, b=-4.0, x0=0.35)
     agree = []
@@ -200,7 +210,6 @@ def test_quick_measured_movement_that_holds_is_kept():
         agree.append(a.symbol_agreement)
         assert a.unmatched == 0
     assert np.mean(agree) >= 0.95
-
 
 
 def _pitch_toes(joints: np.ndarray, deg: float) -> np.ndarray:
@@ -229,8 +238,9 @@ def test_measured_flat_feet_pitched_down_are_not_releve():
     written at beat 0 of Wolofsky's Figure 7).  The relevé threshold is taken
     from the capture's own flat feet."""
     # The left leg gestures forward and back: the right foot alone supports, then both.
-    joints, _ = build_motion([(1, 1, "left_hip", np.radians((40.0, 0.0, 0.0))), (3, 1, "left_hip", np.zeros(3))],
-                             60, beats=5)
+    joints, _ = build_motion(
+        [(1, 1, "left_hip", np.radians((40.0, 0.0, 0.0))), (3, 1, "left_hip", np.zeros(3))], 60, beats=5
+    )
     for bias in (12.0, 18.0):
         noisy = _pitch_toes(joints, bias) + np.random.default_rng(0).normal(0.0, 0.005, joints.shape)
         seg = segment_motion(noisy, 25.0, tempo=60)
@@ -240,7 +250,8 @@ def test_measured_flat_feet_pitched_down_are_not_releve():
         assert (levels == LEVELS.index("middle")).all()
         assert not [x for x in seg.score.symbols if x.is_support and x.level == "high"]
         assert [(x.part, x.direction, x.level) for x in seg.score.symbols if not x.is_support] == [
-            ("left_leg", "forward", "low")]
+            ("left_leg", "forward", "low")
+        ]
 
 
 def test_flat_foot_pitch_is_the_lower_decile_of_contacts():

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
-from capture2notation.effort.model import progress
-from capture2notation.quantise.agreement import normalise
+from capture2notation.compare.agreement import normalise
+from capture2notation.notation.effort import progress
 from capture2notation.quantise.labels import label_frames, with_supports
 from capture2notation.quantise.segment import segment_motion
 from capture2notation.quantise.supports import smooth_positions
@@ -107,11 +107,10 @@ def test_with_supports_rewrites_the_support_columns():
 
 # --- Truth round trip of the support column (virtual dancer → quantiser) ---
 
+from capture2notation.notation import Score, Symbol  # noqa: E402
 from synthetic.interpret import UnreachableWarning, interpret  # noqa: E402
 from synthetic.phrases import phrase  # noqa: E402
 from synthetic.random_scores import random_score  # noqa: E402
-
-from capture2notation.notation import Score, Symbol  # noqa: E402
 
 #: Support phrases (start, duration, part, direction, level), each with the
 #: case it guards.
@@ -119,20 +118,37 @@ SUPPORT_CASES = {
     # (a) both feet, then a transfer onto one foot: starts at 1, not 0.
     "transfer": ["0 1 support place middle", "1 4 right_support place middle"],
     # (a) in context: a transfer, the free leg gestures at once, a closing.
-    "transfer_gesture_close": ["0 1 support place middle", "1 1 right_support place middle",
-                               "2 1 left_leg forward middle", "3 1 support place middle"],
+    "transfer_gesture_close": [
+        "0 1 support place middle",
+        "1 1 right_support place middle",
+        "2 1 left_leg forward middle",
+        "3 1 support place middle",
+    ],
     # (b) a step, then a closing: two symbols, not one.
     "step_close": ["1 1 right_support forward middle", "2 1 support place middle"],
     # (c) a closing immediately followed by a step of the closing foot.
-    "close_then_step": ["1 1 right_support place middle", "2 1 left_leg forward middle",
-                        "3 1 support place middle", "4 1 left_support left middle", "5 1 support place middle"],
+    "close_then_step": [
+        "1 1 right_support place middle",
+        "2 1 left_leg forward middle",
+        "3 1 support place middle",
+        "4 1 left_support left middle",
+        "5 1 support place middle",
+    ],
     # A walk from the first frame, each foot landing and the other stepping at once.
-    "walk": ["0 1 right_support forward middle", "1 1 left_support forward middle",
-             "2 1 right_support forward middle", "3 1 support place middle"],
+    "walk": [
+        "0 1 right_support forward middle",
+        "1 1 left_support forward middle",
+        "2 1 right_support forward middle",
+        "3 1 support place middle",
+    ],
     "plie_releve_middle": ["0 2 support place low", "2 2 support place high", "4 2 support place middle"],
     "releve_on_one_foot": ["0 2 right_support place high", "2 1 left_leg left low", "3 2 support place middle"],
-    "side_steps_then_plie": ["1 1/2 right_support right middle", "3/2 1 support place middle",
-                             "5/2 1 left_support left middle", "7/2 1 support place low"],
+    "side_steps_then_plie": [
+        "1 1/2 right_support right middle",
+        "3/2 1 support place middle",
+        "5/2 1 left_support left middle",
+        "7/2 1 support place low",
+    ],
 }
 
 
@@ -182,7 +198,9 @@ def test_leg_phrase_supports_round_trip_exactly():
     # Spelled out, the cases (a) and (b) of the phrase.
     assert (F(8), F(1), "right_support") in [(s.start, s.duration, s.part) for s in got]
     assert [(s.start, s.part, s.direction) for s in got if s.start >= 12] == [
-        (F(12), "right_support", "forward"), (F(13), "support", "place")]
+        (F(12), "right_support", "forward"),
+        (F(13), "support", "place"),
+    ]
 
 
 def test_random_scores_with_supports_round_trip_their_support_column():
@@ -207,29 +225,69 @@ def test_random_scores_with_supports_round_trip_their_support_column():
 # low`` was split where its thigh and shin passed written directions, and a
 # knee bent by Space mid-gesture made the leg read as noisy motion.
 _BARRE = {
-    "b01": (72, "right", 1, "", ("forward low", "side low", "back low", "side middle", "side low",
-                                 "forward middle bend=2", "place low")),
-    "b02": (96, "left", 2, "", ("forward low", "side low", "back low", "side middle", "side low",
-                                "forward middle bend=2", "place low")),
-    "b03": (56, "right", 1, "", ("side low", "forward low", "side middle", "back low", "forward middle bend=2",
-                                 "side low")),
-    "b04": (120, "left", 2, "", ("side low", "back low", "forward middle bend=2", "side middle", "forward low",
-                                 "side low")),
+    "b01": (
+        72,
+        "right",
+        1,
+        "",
+        ("forward low", "side low", "back low", "side middle", "side low", "forward middle bend=2", "place low"),
+    ),
+    "b02": (
+        96,
+        "left",
+        2,
+        "",
+        ("forward low", "side low", "back low", "side middle", "side low", "forward middle bend=2", "place low"),
+    ),
+    "b03": (
+        56,
+        "right",
+        1,
+        "",
+        ("side low", "forward low", "side middle", "back low", "forward middle bend=2", "side low"),
+    ),
+    "b04": (
+        120,
+        "left",
+        2,
+        "",
+        ("side low", "back low", "forward middle bend=2", "side middle", "forward low", "side low"),
+    ),
     "b05": (64, "right", 1, "", ("forward low", "forward middle bend=2")),
     "b06": (88, "left", 2, "", ("back low", "side middle", "place low")),
     "b07": (80, "right", 1, "", ("side low", "back low", "forward low", "side low")),
     "b08": (108, "left", 2, "", ("forward middle bend=2", "side low", "back low", "place low")),
-    "b09": (60, "right", 1, "", ("back low", "side low", "forward low", "forward middle bend=2", "place low",
-                                 "side middle")),
+    "b09": (
+        60,
+        "right",
+        1,
+        "",
+        ("back low", "side low", "forward low", "forward middle bend=2", "place low", "side middle"),
+    ),
     "b10": (100, "left", 2, "", ("side middle", "forward low", "back low", "side low", "forward middle bend=2")),
-    "b11": (84, "right", 4, "emotion: happy", ("side low", "place low", "forward low", "forward middle bend=2",
-                                               "side middle", "place low")),
-    "b12": (112, "left", 2, "effort: time=-3.5 weight=0.41 space=1", ("place low", "back low", "side low",
-                                                                     "forward middle bend=2", "side low")),
+    "b11": (
+        84,
+        "right",
+        4,
+        "emotion: happy",
+        ("side low", "place low", "forward low", "forward middle bend=2", "side middle", "place low"),
+    ),
+    "b12": (
+        112,
+        "left",
+        2,
+        "effort: time=-3.5 weight=0.41 space=1",
+        ("place low", "back low", "side low", "forward middle bend=2", "side low"),
+    ),
     # Indirect Space and light Effort: the knee bends and straightens within
     # every gesture, which at 12.5 fps once made the leg's motion look noisy.
-    "b13": (113, "right", 1, "effort: time=-2.2 weight=0.7 space=0.5", ("side middle", "place low", "forward low",
-                                                                        "place low")),
+    "b13": (
+        113,
+        "right",
+        1,
+        "effort: time=-2.2 weight=0.7 space=0.5",
+        ("side middle", "place low", "forward low", "place low"),
+    ),
     "b14": (96, "left", 1, "emotion: happy", ("place low", "back low", "place low", "side low", "place low")),
 }
 
@@ -239,8 +297,14 @@ def _barre_score(name):
 
     tempo, support, hold, effort, gestures = _BARRE[name]
     free = "left" if support == "right" else "right"
-    lines = [f"title: barre {name}", f"tempo: {tempo}", "meter: 4", effort,
-             "0 1 support place middle", f"1 {hold} {support}_support place middle"]
+    lines = [
+        f"title: barre {name}",
+        f"tempo: {tempo}",
+        "meter: 4",
+        effort,
+        "0 1 support place middle",
+        f"1 {hold} {support}_support place middle",
+    ]
     t = 1 + hold
     for g in gestures:
         lines.append(f"{t} 1 {free}_leg {g.replace('side', free)}")
@@ -253,7 +317,7 @@ def _barre_score(name):
 @pytest.mark.parametrize("name", sorted(_BARRE))
 def test_barre_exercise_round_trips_exactly(name, fps):
     """Truth joints of a barre exercise quantise back to its score, and the dancer reaches every symbol."""
-    from capture2notation.quantise.agreement import score_differences
+    from capture2notation.compare.agreement import score_differences
     from synthetic.interpret import interpret
     from synthetic.reach import UnreachableWarning
 

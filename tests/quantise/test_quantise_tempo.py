@@ -95,8 +95,28 @@ def test_too_few_times_need_a_given_tempo():
 # Key times (s) and gesture durations (s) from the whole path (render 25 fps,
 # BlazePose, 3D fit) of a development leg phrase written at 60 bpm: four
 # one-beat gestures and five spurious short ones (jitter of the fitted legs).
-_LEGS60_TIMES = [3.974, 5.028, 2.043, 2.335, 2.719, 3.059, 3.49, 4.205, 3.859, 5.17,
-                 6.948, 7.994, 1.839, 2.99, 3.42, 3.964, 4.4, 4.724, 4.782, 4.985]
+_LEGS60_TIMES = [
+    3.974,
+    5.028,
+    2.043,
+    2.335,
+    2.719,
+    3.059,
+    3.49,
+    4.205,
+    3.859,
+    5.17,
+    6.948,
+    7.994,
+    1.839,
+    2.99,
+    3.42,
+    3.964,
+    4.4,
+    4.724,
+    4.782,
+    4.985,
+]
 _LEGS60_DURATIONS = [1.054, 0.292, 0.34, 0.715, 1.311, 1.047, 1.151, 0.544, 0.324, 0.203]
 
 
@@ -104,8 +124,9 @@ def test_captured_phrase_with_spurious_short_movements_is_not_doubled():
     """The spurious short movements used to read 60 bpm as 121 (their
     durations, at one beat each, pulled the tempo up); with durations
     robust to outliers and a prior over dance tempi it stays 60."""
-    est = estimate_tempo_detail(_LEGS60_TIMES, tolerance_s=0.08, durations=_LEGS60_DURATIONS,
-                                groups=np.tile([0, 1], 10), max_offset_s=0.12)
+    est = estimate_tempo_detail(
+        _LEGS60_TIMES, tolerance_s=0.08, durations=_LEGS60_DURATIONS, groups=np.tile([0, 1], 10), max_offset_s=0.12
+    )
     assert abs(est.tempo - 60) <= 1
     assert 0.0 < est.confidence <= 1.0 and est.runner_up is not None and abs(est.runner_up - est.tempo) > 9
 

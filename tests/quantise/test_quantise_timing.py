@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from capture2notation.effort.model import progress
+from capture2notation.notation.effort import progress
 from capture2notation.quantise.timing import fit_movement_times, progress_signal, refine_times
 
 FPS = 25.0

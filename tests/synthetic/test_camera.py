@@ -40,8 +40,14 @@ def test_optical_axis_projects_to_principal_point(pos, target, fov, size, k):
 
 
 @settings(max_examples=60, deadline=None)
-@given(point, point, st.floats(10.0, 120.0), sizes,
-       st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)), st.floats(0.05, 30.0))
+@given(
+    point,
+    point,
+    st.floats(10.0, 120.0),
+    sizes,
+    st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)),
+    st.floats(0.05, 30.0),
+)
 def test_back_projection_round_trip(pos, target, fov, size, frac, depth):
     cam = _camera(pos, target, fov, size)
     if cam is None:

@@ -8,6 +8,7 @@ the steps into and out of a frame, as the quantiser measures it; low = knee
 bent more than 30°; high = heel raised).
 """
 
+import itertools
 import warnings
 from fractions import Fraction
 
@@ -17,10 +18,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from capture2notation.body import Body, global_rotations, joint_index, segment_vectors
-from capture2notation.effort.model import progress
 from capture2notation.errors import SyntheticError
 from capture2notation.notation import PART_MIDDLE_JOINT, PART_SEGMENTS, Effort, Score, Symbol
 from capture2notation.notation.directions import bend_angle, bend_degree, canonical_vector, classify_indices
+from capture2notation.notation.effort import progress
 from capture2notation.notation.model import DIRECTIONS, LEVELS
 from synthetic.interpret import STEP_LENGTH, UnreachableWarning, interpret, unreachable
 from synthetic.phrases import PHRASE_NAMES, builtin_phrases, phrase
@@ -281,7 +282,7 @@ def test_steps_and_landings_arrive_within_one_frame_of_their_end(fps):
         Symbol(4, 1, "support", "place", "middle"),
     )
     m, J = assert_round_trip(Score(syms, tempo=90), fps)
-    for sym, f0, f1 in m.events:
+    for sym, _f0, f1 in m.events:
         if sym.part == "left_leg":
             continue
         foot = FEET[sym.part][0] if sym.part != "support" else "left"
@@ -312,8 +313,10 @@ def test_figure7_leg_sweeps_at_hip_height_within_the_extremes():
         ((Symbol(0, 1, "head", "right", "middle"),), ("head right middle", "neck ry")),
         ((Symbol(0, 1, "chest", "back", "middle"),), ("chest back middle", "waist rx")),
         ((Symbol(0, 1, "chest", "forward", "middle"),), ("head place high (the start pose) cannot be held", "neck rx")),
-        ((Symbol(0, 1, "left_support", "place", "middle"), Symbol(1, 1, "right_leg", "left", "middle")),
-         ("right_leg left middle", "right_hip rz <= 60")),
+        (
+            (Symbol(0, 1, "left_support", "place", "middle"), Symbol(1, 1, "right_leg", "left", "middle")),
+            ("right_leg left middle", "right_hip rz <= 60"),
+        ),
     ],
 )
 def test_unreachable_symbols_warn_naming_the_symbol_and_the_extreme(syms, names):
@@ -355,7 +358,7 @@ def test_random_scores_are_valid_and_reproducible():
             assert s.part in {"right_arm", "head", "left_leg", "right_leg"} | set(FEET)
         for part in {s.part for s in a.symbols}:
             seq = a.for_part(part)
-            for x, y in zip(seq, seq[1:]):
+            for x, y in itertools.pairwise(seq):
                 assert x.end <= y.start
                 if not x.is_support:
                     assert (x.direction, x.level, x.bend) != (y.direction, y.level, y.bend)

@@ -212,7 +212,7 @@ def test_stick_figure_is_black_lines_on_white():
     img = make_renderer(_pose(), cam, "stick").frame(0)
     a, b = cam.project(_pose().points["right_hip"][0]), cam.project(_pose().points["right_knee"][0])
     mid = np.round((a + b) / 2).astype(int)
-    assert img[mid[1] - 1:mid[1] + 2, mid[0] - 1:mid[0] + 2].min() < 60
+    assert img[mid[1] - 1 : mid[1] + 2, mid[0] - 1 : mid[0] + 2].min() < 60
     assert np.median(img) > 200
 
 
@@ -293,7 +293,9 @@ def test_visibility_of_a_long_take_equals_frame_by_frame():
     cam = Camera.for_view("45", SIZE, BODY.height)
     a, b, r = body_capsules(pose)
     whole = point_visibility(cam, pose.landmarks, a, b, r)
-    single = np.concatenate([point_visibility(cam, pose.landmarks[i:i + 1], a[i:i + 1], b[i:i + 1], r) for i in range(n)])
+    single = np.concatenate(
+        [point_visibility(cam, pose.landmarks[i : i + 1], a[i : i + 1], b[i : i + 1], r) for i in range(n)]
+    )
     np.testing.assert_array_equal(whole, single)
     assert 0.3 < whole.mean() < 0.95  # random poses hide some points, not all
 

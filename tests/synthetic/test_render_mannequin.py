@@ -25,7 +25,7 @@ def _pose(**set_angles):
 
 def _patch(img, uv, r=2):
     u, v = np.round(uv).astype(int)
-    return img[v - r:v + r + 1, u - r:u + r + 1].reshape(-1, 3).mean(axis=0)
+    return img[v - r : v + r + 1, u - r : u + r + 1].reshape(-1, 3).mean(axis=0)
 
 
 def test_head_tilted_back_shows_its_face_from_below():

@@ -27,9 +27,13 @@ def test_a_closing_foot_stands_before_it_steps_again(fps):
     """Close on beat 3, step with the same foot from beat 3: the foot is on the
     floor and still at the close's end frame (the weight arrives there), and
     leaves it only afterwards."""
-    syms = (Symbol(F(1), F(1), "right_support", "place", "middle"), Symbol(F(2), F(1), "left_leg", "forward", "middle"),
-            Symbol(F(3), F(1), "support", "place", "middle"), Symbol(F(4), F(1), "left_support", "left", "middle"),
-            Symbol(F(6), F(1), "right_arm", "forward", "middle"))  # the step's landing is followed by a hold
+    syms = (
+        Symbol(F(1), F(1), "right_support", "place", "middle"),
+        Symbol(F(2), F(1), "left_leg", "forward", "middle"),
+        Symbol(F(3), F(1), "support", "place", "middle"),
+        Symbol(F(4), F(1), "left_support", "left", "middle"),
+        Symbol(F(6), F(1), "right_arm", "forward", "middle"),
+    )  # the step's landing is followed by a hold
     m = interpret(Score(syms, title="close then step", tempo=F(72), meter=4), fps=fps)
     J = m.joints()
     f3 = {s.start: f1 for s, f0, f1 in m.events if s.part == "support"}[F(3)]
@@ -60,12 +64,19 @@ def test_a_gesturing_foot_leaves_the_floor_on_its_start(fps):
     """A leg gesture begins at its start (DESIGN.md): with a slow-starting
     Effort the logistic alone keeps the foot within 3 cm and slower than
     0.2 m/s for a fifth of the gesture; the dancer lifts it off at once."""
-    score = Score((_sym(0, 2, "right_support", "place", "middle"), _sym(2, 2, "left_leg", "forward", "middle", 1),
-                   _sym(4, 3 / 2, "support", "place", "middle")), tempo=F(92), meter=4,
-                  effort=Effort(time=-3.377, weight=0.671, space=0.928))
+    score = Score(
+        (
+            _sym(0, 2, "right_support", "place", "middle"),
+            _sym(2, 2, "left_leg", "forward", "middle", 1),
+            _sym(4, 3 / 2, "support", "place", "middle"),
+        ),
+        tempo=F(92),
+        meter=4,
+        effort=Effort(time=-3.377, weight=0.671, space=0.928),
+    )
     m = interpret(score, fps)
     sup = _contact(m.joints(), fps, "left")
-    f0 = dict((s.part, f) for s, f, _ in m.events)["left_leg"]
+    f0 = {s.part: f for s, f, _ in m.events}["left_leg"]
     assert sup[f0] and not sup[f0 + 1 : f0 + 4].any(), np.flatnonzero(sup)
 
 
@@ -76,9 +87,16 @@ def test_a_foot_released_by_a_step_holds_its_leg():
     gesture for the quantiser)."""
     from capture2notation.body import body_frame, segment_vectors
 
-    score = Score((_sym(0, F(1, 2), "right_support", "back", "middle"), _sym(F(1, 2), F(3, 2), "right_support", "place", "high"),
-                   _sym(2, 1, "left_leg", "left_forward", "low", 2), _sym(3, F(3, 2), "support", "place", "middle")),
-                  tempo=F(101), meter=4)
+    score = Score(
+        (
+            _sym(0, F(1, 2), "right_support", "back", "middle"),
+            _sym(F(1, 2), F(3, 2), "right_support", "place", "high"),
+            _sym(2, 1, "left_leg", "left_forward", "low", 2),
+            _sym(3, F(3, 2), "support", "place", "middle"),
+        ),
+        tempo=F(101),
+        meter=4,
+    )
     m = interpret(score, 25.0)
     J = m.joints()
     v = segment_vectors(J, "left_hip", "left_ankle", body_frame(J))
@@ -93,21 +111,32 @@ def test_a_heel_lowered_slowly_steps_at_once_at_low_frame_rates():
     """A foot whose heel comes down from relevé slower than 0.2 m/s already
     rests when its step starts: it does not rest a frame more (at 12.5 fps
     that left it supporting two frames before the step's end)."""
-    score = Score((_sym(0, F(3, 2), "right_support", "back", "middle"), _sym(F(3, 2), F(3, 2), "right_support", "place", "high"),
-                   _sym(3, F(1, 2), "left_leg", "right_forward", "low"), _sym(F(7, 2), F(3, 2), "support", "place", "middle"),
-                   _sym(5, F(1, 2), "right_support", "right", "middle"), _sym(5, 1, "right_arm", "forward", "middle")),
-                  tempo=F(108), meter=4)
+    score = Score(
+        (
+            _sym(0, F(3, 2), "right_support", "back", "middle"),
+            _sym(F(3, 2), F(3, 2), "right_support", "place", "high"),
+            _sym(3, F(1, 2), "left_leg", "right_forward", "low"),
+            _sym(F(7, 2), F(3, 2), "support", "place", "middle"),
+            _sym(5, F(1, 2), "right_support", "right", "middle"),
+            _sym(5, 1, "right_arm", "forward", "middle"),
+        ),
+        tempo=F(108),
+        meter=4,
+    )
     fps = 12.5
     m = interpret(score, fps)
     sup = _contact(m.joints(), fps, "right")
-    (f0, f1), = [(a, b) for x, a, b in m.events if x.part == "right_support" and x.direction == "right"]
+    ((f0, f1),) = [(a, b) for x, a, b in m.events if x.part == "right_support" and x.direction == "right"]
     assert f1 - f0 == 3 and sup[f0] and not sup[f1 - 2] and sup[f1]
 
 
 def _barre(support="right", hold=1, gestures=("left low", "place low"), tempo=72):
     """Weight onto one foot, one-beat free-leg gestures, a close, then a hold (an arm moves on)."""
     free = "left" if support == "right" else "right"
-    syms = [Symbol(F(0), F(1), "support", "place", "middle"), Symbol(F(1), F(hold), f"{support}_support", "place", "middle")]
+    syms = [
+        Symbol(F(0), F(1), "support", "place", "middle"),
+        Symbol(F(1), F(hold), f"{support}_support", "place", "middle"),
+    ]
     t = 1 + hold
     for g in gestures:
         d, lv, *bend = g.replace("side", free).split()
@@ -152,4 +181,4 @@ def test_a_closing_foot_lands_on_the_close_end_frame(fps, last):
     J = m.joints()
     f0, f1 = [(a, b) for s, a, b in m.events if s.part == "support"][-1]
     c = _contact(J, fps, free)
-    assert c[f1] and not c[f0 : f1].any()
+    assert c[f1] and not c[f0:f1].any()

@@ -17,23 +17,23 @@ format                    file names                                read   write
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Callable
 
 from ...errors import ScoreFormatError
 from ..model import Score
 
 __all__ = [
     "ScoreFormat",
-    "register_format",
-    "formats",
-    "format_for",
-    "read",
-    "write",
-    "loads",
     "dumps",
+    "format_for",
+    "formats",
+    "loads",
+    "read",
+    "register_format",
+    "write",
 ]
 
 
@@ -128,9 +128,7 @@ def dumps(score: Score, format: str) -> str:
     """Serialise `score` in the named `format`."""
     fmt = format_for(None, format)
     if fmt.dumps is None:
-        raise ScoreFormatError(
-            f"the {fmt.name} format ({fmt.description}) is read-only; write .lab or .json instead"
-        )
+        raise ScoreFormatError(f"the {fmt.name} format ({fmt.description}) is read-only; write .lab or .json instead")
     return fmt.dumps(score)
 
 
@@ -178,7 +176,7 @@ def write(score: Score, path, format: str | None = None) -> Path:
             str(path),
         )
     # Imported late: io may itself import the notation formats (truth sidecar).
-    from ...io.atomic import write_text
+    from ...atomic import write_text
 
     return write_text(path, fmt.dumps(score))
 

@@ -22,12 +22,13 @@ from __future__ import annotations
 import json
 import math
 from fractions import Fraction
+from typing import Any, NoReturn
 
 from ...errors import NotationError, ScoreFormatError
 from ..model import EMOTIONS, Effort, Score, Symbol, as_fraction
 from .lab import format_fraction
 
-__all__ = ["score_to_dict", "score_from_dict", "loads", "dumps", "FORMAT_TAG", "VERSION"]
+__all__ = ["FORMAT_TAG", "VERSION", "dumps", "loads", "score_from_dict", "score_to_dict"]
 
 FORMAT_TAG = "capture2notation.score"
 VERSION = 1
@@ -70,7 +71,7 @@ class _Where:
     def __init__(self, path: str | None):
         self.path = path
 
-    def fail(self, jpath: str, message: str):
+    def fail(self, jpath: str, message: str) -> NoReturn:
         raise ScoreFormatError(f"{jpath}: {message}" if jpath else message, self.path)
 
 
@@ -137,7 +138,7 @@ def score_from_dict(data, path: str | None = None) -> Score:
         where.fail("format", f"expected {FORMAT_TAG!r}, got {json.dumps(data['format'])}")
     if "version" in data and data["version"] != VERSION:
         where.fail("version", f"unsupported version {json.dumps(data['version'])}; expected {VERSION}")
-    kw = {}
+    kw: dict[str, Any] = {}
     title = data.get("title", "")
     if not isinstance(title, str) or "\n" in title:
         where.fail("title", f"expected a one-line string, got {json.dumps(title)}")

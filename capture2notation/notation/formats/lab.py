@@ -33,11 +33,12 @@ import json
 import math
 import re
 from fractions import Fraction
+from typing import Any
 
 from ...errors import NotationError, ScoreFormatError
 from ..model import DIRECTIONS, EMOTIONS, LEVELS, PARTS, Effort, Score, Symbol
 
-__all__ = ["loads", "dumps", "format_fraction", "parse_fraction", "check_overlaps", "COLUMNS"]
+__all__ = ["COLUMNS", "check_overlaps", "dumps", "format_fraction", "loads", "parse_fraction"]
 
 #: The symbol columns, as named in the column comment the writer emits.
 COLUMNS = "start duration part direction level [bend=N]"
@@ -108,9 +109,7 @@ def _parse_effort(value: str) -> Effort:
     for token in _strip_comment(value).split():
         key, sep, num = token.partition("=")
         if not sep or key not in EFFORT_KEYS:
-            raise NotationError(
-                f"effort item {token!r} is not understood; expected time=B weight=X0 space=S"
-            )
+            raise NotationError(f"effort item {token!r} is not understood; expected time=B weight=X0 space=S")
         if key in got:
             raise NotationError(f"effort {key} is given twice")
         try:
@@ -122,9 +121,7 @@ def _parse_effort(value: str) -> Effort:
         got[key] = x
     missing = [k for k in EFFORT_KEYS if k not in got]
     if missing:
-        raise NotationError(
-            f"effort is missing {' '.join(missing)}; expected time=B weight=X0 space=S"
-        )
+        raise NotationError(f"effort is missing {' '.join(missing)}; expected time=B weight=X0 space=S")
     return Effort(**got)
 
 
@@ -149,18 +146,14 @@ def _parse_symbol(line: str) -> Symbol:
     if tokens and tokens[0] in HEADER_KEYS:
         raise NotationError(f"header {tokens[0]!r} needs a colon, e.g. '{tokens[0]}: …'")
     if len(tokens) < 5:
-        raise NotationError(
-            f"expected the columns '{COLUMNS}', got {len(tokens)} column(s): {' '.join(tokens)!r}"
-        )
+        raise NotationError(f"expected the columns '{COLUMNS}', got {len(tokens)} column(s): {' '.join(tokens)!r}")
     start_t, dur_t, part, direction, level = tokens[:5]
     start = parse_fraction(start_t, "start")
     duration = parse_fraction(dur_t, "duration")
     if part not in PARTS:
         raise NotationError(f"unknown part {part!r}; expected one of {' '.join(PARTS)}")
     if direction not in DIRECTIONS:
-        raise NotationError(
-            f"unknown direction {direction!r}; expected one of {' '.join(DIRECTIONS)}"
-        )
+        raise NotationError(f"unknown direction {direction!r}; expected one of {' '.join(DIRECTIONS)}")
     if level not in LEVELS:
         raise NotationError(f"unknown level {level!r}; expected one of {' '.join(LEVELS)}")
     bend = None
@@ -205,8 +198,7 @@ def loads(text: str, path: str | None = None) -> Score:
                 key = m.group(1)
                 if key not in _HEADER_PARSERS:
                     raise NotationError(
-                        f"unknown header {key + ':'!r}; expected one of "
-                        f"{' '.join(k + ':' for k in HEADER_KEYS)}"
+                        f"unknown header {key + ':'!r}; expected one of {' '.join(k + ':' for k in HEADER_KEYS)}"
                     )
                 if key in header:
                     raise NotationError(f"'{key}:' is given twice (first on line {header[key][1]})")
@@ -218,11 +210,9 @@ def loads(text: str, path: str | None = None) -> Score:
 
     if "effort" in header and "emotion" in header:
         later = max(header["effort"][1], header["emotion"][1])
-        raise ScoreFormatError(
-            "a score carries either 'effort:' or 'emotion:', not both", path, later
-        )
+        raise ScoreFormatError("a score carries either 'effort:' or 'emotion:', not both", path, later)
     check_overlaps(rows, path)
-    kw = {key: value for key, (value, _) in header.items()}
+    kw: dict[str, Any] = {key: value for key, (value, _) in header.items()}
     try:
         return Score(symbols=tuple(s for s, _ in rows), **kw)
     except NotationError as exc:
@@ -276,9 +266,7 @@ def dumps(score: Score) -> str:
         lines.append(f"effort: time={e.time!r} weight={e.weight!r} space={e.space!r}")
     if score.emotion is not None:
         lines.append(f"emotion: {score.emotion}")
-    lines.append(
-        f"# {'start':<7} {'duration':<9} {'part':<16} {'direction':<14} {'level':<7} [bend=N]"
-    )
+    lines.append(f"# {'start':<7} {'duration':<9} {'part':<16} {'direction':<14} {'level':<7} [bend=N]")
     for s in score.symbols:
         row = (
             f"{format_fraction(s.start):<9} {format_fraction(s.duration):<9} "

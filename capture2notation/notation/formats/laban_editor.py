@@ -59,13 +59,13 @@ from ..directions import BEND_STEP_DEG, canonical_vector, classify
 from ..model import Score, Symbol
 
 __all__ = [
-    "loads",
-    "dumps",
-    "score_to_laban_editor",
-    "write_laban_editor",
-    "arm_segments",
     "DIRECTION_NAMES",
     "LEVEL_NAMES",
+    "arm_segments",
+    "dumps",
+    "loads",
+    "score_to_laban_editor",
+    "write_laban_editor",
 ]
 
 DIRECTION_NAMES: MappingProxyType = MappingProxyType(
@@ -94,8 +94,13 @@ _FIELDS = (
     ("left wrist", "left_forearm", "left_arm", 1),
 )
 #: Starting pose of DESIGN.md for the parts this format carries.
-_START = {"head": ("place", "high"), "right_upper_arm": ("place", "low"), "right_forearm": ("place", "low"),
-          "left_upper_arm": ("place", "low"), "left_forearm": ("place", "low")}
+_START = {
+    "head": ("place", "high"),
+    "right_upper_arm": ("place", "low"),
+    "right_forearm": ("place", "low"),
+    "left_upper_arm": ("place", "low"),
+    "left_forearm": ("place", "low"),
+}
 _ROTATION = ["ToLeft", "0"]
 _ANY_ARM_OR_HEAD = frozenset(
     {"head", "right_arm", "left_arm", "right_upper_arm", "right_forearm", "left_upper_arm", "left_forearm"}
@@ -152,7 +157,7 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
     # Apply symbols in order of arrival; a later symbol on a segment wins.
     events = sorted(relevant, key=lambda s: (s.end, s.start))
     state = dict(_START)
-    positions = {}
+    positions: dict = {}
     k = 0
     prev_ms = 0
     for t in times:
@@ -193,7 +198,7 @@ def write_laban_editor(score: Score, path, name: str | None = None) -> Path:
         Score name inside the file; default the title, else the file stem
         (the suite names a score after its file).
     """
-    from ...io.atomic import write_text
+    from ...atomic import write_text
 
     return write_text(path, dumps(score, name or score.title or Path(path).stem))
 
@@ -203,9 +208,7 @@ def _pair(value, where: str, path) -> tuple[str, str]:
         raise ScoreFormatError(f"{where}: expected [Direction, Level] strings, got {json.dumps(value)}", path)
     d, lv = value
     if d not in _DIRECTION_BACK:
-        raise ScoreFormatError(
-            f"{where}: unknown direction {d!r}; expected one of {', '.join(_DIRECTION_BACK)}", path
-        )
+        raise ScoreFormatError(f"{where}: unknown direction {d!r}; expected one of {', '.join(_DIRECTION_BACK)}", path)
     if lv not in _LEVEL_BACK:
         raise ScoreFormatError(f"{where}: unknown level {lv!r}; expected one of {', '.join(_LEVEL_BACK)}", path)
     return _DIRECTION_BACK[d], _LEVEL_BACK[lv]
@@ -235,7 +238,7 @@ def loads(text: str, path: str | None = None) -> Score:
     except json.JSONDecodeError as exc:
         raise ScoreFormatError(f"invalid JSON: {exc.msg} (column {exc.colno})", path, exc.lineno) from None
     if not isinstance(data, dict) or len(data) != 1 or not isinstance(next(iter(data.values())), dict):
-        raise ScoreFormatError("expected one score: {name: {\"Position0\": {...}, ...}}", path)
+        raise ScoreFormatError('expected one score: {name: {"Position0": {...}, ...}}', path)
     name, positions = next(iter(data.items()))
     poses = []
     for key, pose in positions.items():
@@ -268,6 +271,6 @@ def loads(text: str, path: str | None = None) -> Score:
             current[part] = target
         prev_ms = ms
     try:
-        return Score(symbols=tuple(symbols), title=str(name).replace("\n", " "), tempo=60, meter=4)
+        return Score(symbols=tuple(symbols), title=str(name).replace("\n", " "), tempo=Fraction(60), meter=4)
     except NotationError as exc:
         raise ScoreFormatError(str(exc), path) from None

@@ -37,7 +37,7 @@ from ...errors import NotationError, ScoreFormatError
 from ..model import Score, Symbol
 from .lab import check_overlaps, parse_fraction
 
-__all__ = ["loads", "PART_CODES", "DIRECTION_CODES", "LEVEL_CODES", "DEFAULT_TEMPO", "DEFAULT_METER"]
+__all__ = ["DEFAULT_METER", "DEFAULT_TEMPO", "DIRECTION_CODES", "LEVEL_CODES", "PART_CODES", "loads"]
 
 DEFAULT_TEMPO = Fraction(60)
 DEFAULT_METER = 4
@@ -141,6 +141,4 @@ def loads(text: str, path: str | None = None) -> Score:
             raise ScoreFormatError(str(exc), path, lineno) from None
     check_overlaps(rows, path)
     title = Path(path).stem.replace("\n", " ") if path else ""
-    return Score(
-        symbols=tuple(s for s, _ in rows), title=title, tempo=DEFAULT_TEMPO, meter=DEFAULT_METER
-    )
+    return Score(symbols=tuple(s for s, _ in rows), title=title, tempo=DEFAULT_TEMPO, meter=DEFAULT_METER)

@@ -2,7 +2,7 @@ from pathlib import Path
 
 import pytest
 
-from capture2notation.io.atomic import atomic_path, write_text
+from capture2notation.atomic import atomic_path, write_text
 
 
 def test_write_text_replaces_whole_file(tmp_path):
@@ -15,20 +15,18 @@ def test_write_text_replaces_whole_file(tmp_path):
 
 def test_failed_write_leaves_no_file_and_no_temp(tmp_path):
     p = tmp_path / "out.json"
-    with pytest.raises(RuntimeError):
-        with atomic_path(p) as tmp:
-            Path(tmp).write_text("half")
-            raise RuntimeError("boom")
+    with pytest.raises(RuntimeError), atomic_path(p) as tmp:
+        Path(tmp).write_text("half")
+        raise RuntimeError("boom")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_failed_write_keeps_previous_version(tmp_path):
     p = tmp_path / "out.txt"
     write_text(p, "good")
-    with pytest.raises(ValueError):
-        with atomic_path(p) as tmp:
-            Path(tmp).write_text("bad")
-            raise ValueError
+    with pytest.raises(ValueError), atomic_path(p) as tmp:
+        Path(tmp).write_text("bad")
+        raise ValueError
     assert p.read_text() == "good"
 
 

@@ -1,20 +1,42 @@
-"""The Laban Effort model of one movement (Neagle §5.4–5.5, DESIGN.md).
+"""Laban Effort in the notation (Neagle §5.4–5.5, DESIGN.md): the value, its model and the emotion presets.
 
-Pure functions shared by the virtual dancer (which animates with them) and the
-estimator (which fits them).
+The logistic :func:`progress` and the :func:`space_radius` modulation are
+the meaning of an :class:`Effort`: the virtual dancer animates with them and
+the estimator (:mod:`capture2notation.effort`) fits them, so they live with
+the value they interpret, below both.  Afraid's space is not given by
+Neagle; 0.5 is this project's assumption.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from fractions import Fraction
+from types import MappingProxyType
+
 import numpy as np
 
-from ..errors import EffortError
+from ..errors import EffortError, NotationError
 
-__all__ = ["TIME_RANGE", "WEIGHT_RANGE", "progress", "progress_speed", "space_radius"]
+__all__ = [
+    "EMOTIONS",
+    "PRESETS",
+    "SPACE_RANGE",
+    "TIME_RANGE",
+    "WEIGHT_RANGE",
+    "Effort",
+    "Preset",
+    "progress",
+    "progress_speed",
+    "space_radius",
+]
 
 #: Working ranges of the estimator's uniform priors.
 TIME_RANGE = (-5.0, -1.5)
 WEIGHT_RANGE = (0.05, 0.95)
+#: Space S: 0 indirect … 1 direct.
+SPACE_RANGE = (0.0, 1.0)
+#: Emotions with a preset (DESIGN.md table).
+EMOTIONS: tuple[str, ...] = ("happy", "sad", "angry", "afraid")
 
 
 def progress(tau, b, x0):
@@ -89,3 +111,49 @@ def space_radius(r, space, tau, outward: bool = False, reach=None):
     if reach is None:
         raise EffortError("outward space modulation needs the limb's full reach")
     return r + (1.0 - space) * (np.maximum(float(reach), r) - r) * bump
+
+
+@dataclass(frozen=True)
+class Effort:
+    """Laban Effort of the logistic interpolation (Neagle §5.4–5.5).
+
+    Parameters
+    ----------
+    time : float
+        Gradient b of the logistic, about −2 (sustained) to −4 (sudden);
+        working range [−5, −1.5].
+    weight : float
+        Centroid x0 in (0, 1) where speed peaks: 0.3–0.4 heavy, 0.6–0.8 light.
+    space : float
+        S in [0, 1]: 1 direct, 0 indirect.
+    """
+
+    time: float = -2.0
+    weight: float = 0.5
+    space: float = 1.0
+
+    def __post_init__(self):
+        for name, (lo, hi) in (("time", TIME_RANGE), ("weight", WEIGHT_RANGE), ("space", SPACE_RANGE)):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or not (lo <= v <= hi):
+                raise NotationError(f"effort {name}={v!r} is outside its working range [{lo}, {hi}]")
+            object.__setattr__(self, name, float(v))
+
+
+@dataclass(frozen=True)
+class Preset:
+    """An emotion's Effort and tempo."""
+
+    emotion: str
+    effort: Effort
+    tempo: Fraction
+
+
+PRESETS: MappingProxyType = MappingProxyType(
+    {
+        "happy": Preset("happy", Effort(time=-2.42, weight=0.60, space=0.0), Fraction(80)),
+        "sad": Preset("sad", Effort(time=-2.19, weight=0.52, space=0.0), Fraction(37)),
+        "angry": Preset("angry", Effort(time=-3.51, weight=0.41, space=1.0), Fraction(79)),
+        "afraid": Preset("afraid", Effort(time=-2.3, weight=0.52, space=0.5), Fraction(43)),
+    }
+)

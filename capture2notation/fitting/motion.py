@@ -18,13 +18,13 @@ import numpy as np
 
 from ..body import JOINTS, Body, joint_index
 from ..errors import MotionFileError
-from ..fitting.fit3d import fit_points3d
-from ..fitting.model import PoseModel
-from ..fitting.result import FitResult
-from .bvh import parse_bvh, read_bvh_points, read_own_bvh
-from .kinect import kinect_points, read_kinect_csv
+from ..io.bvh import parse_bvh, read_bvh_points, read_own_bvh
+from ..io.kinect import kinect_points, read_kinect_csv
+from .fit3d import fit_points3d
+from .model import PoseModel
+from .result import FitResult
 
-__all__ = ["MotionData", "read_motion", "normalise_world", "motion_from_truth"]
+__all__ = ["MotionData", "motion_from_truth", "normalise_world", "read_motion"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,8 +84,16 @@ def _own_motion(fps, angles, root, offsets) -> MotionData:
     model = PoseModel(Body(), offsets)
     joints = model.forward(model.params(angles, root))[:, : len(JOINTS)]
     T = angles.shape[0]
-    return MotionData(fps=fps, times=np.arange(T) / fps, joints=joints, angles=angles, root=root,
-                      confidence=np.ones((T, len(JOINTS))), offsets=offsets, source="bvh")
+    return MotionData(
+        fps=fps,
+        times=np.arange(T) / fps,
+        joints=joints,
+        angles=angles,
+        root=root,
+        confidence=np.ones((T, len(JOINTS))),
+        offsets=offsets,
+        source="bvh",
+    )
 
 
 def _fit(points, conf, head, head_c, fps, times, body, source) -> MotionData:
@@ -98,7 +106,7 @@ def _fit(points, conf, head, head_c, fps, times, body, source) -> MotionData:
 
 def motion_from_truth(path) -> MotionData:
     """A truth sidecar as :class:`MotionData` (confidence 1 wherever joints are finite)."""
-    from .truth import read_truth
+    from ..io.truth import read_truth
 
     tr = read_truth(path)
     names = [str(n) for n in np.asarray(tr.joint_names).tolist()]
@@ -113,9 +121,16 @@ def motion_from_truth(path) -> MotionData:
     angles = np.asarray(tr.angles, float)[:, order]
     conf = np.all(np.isfinite(joints), axis=-1).astype(float)
     body = Body(float(tr.body_height))
-    return MotionData(fps=float(tr.fps), times=np.asarray(tr.times, float), joints=joints, angles=angles,
-                      root=np.asarray(tr.root, float).reshape(T, 3), confidence=conf.reshape(T, J),
-                      offsets=np.array(body.offsets), source="truth")
+    return MotionData(
+        fps=float(tr.fps),
+        times=np.asarray(tr.times, float),
+        joints=joints,
+        angles=angles,
+        root=np.asarray(tr.root, float).reshape(T, 3),
+        confidence=conf.reshape(T, J),
+        offsets=np.array(body.offsets),
+        source="truth",
+    )
 
 
 def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
@@ -149,7 +164,9 @@ def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
     fz = np.where(ok[:, feet], points[:, feet, 2] - rest[feet, 2], np.nan)
     if not np.any(np.isfinite(fz)):
         raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
-    floor = np.nanpercentile(np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2)
+    floor = np.nanpercentile(
+        np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2
+    )
     right = None
     for a, b in (("right_hip", "left_hip"), ("right_shoulder", "left_shoulder")):
         ia, ib = joint_index(a), joint_index(b)

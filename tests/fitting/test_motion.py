@@ -8,7 +8,7 @@ import pytest
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.errors import MotionFileError
 from capture2notation.fitting import FitResult
-from capture2notation.io.motion import MotionData, normalise_world, read_motion
+from capture2notation.fitting.motion import MotionData, normalise_world, read_motion
 from capture2notation.io.truth import write_truth
 
 
@@ -22,10 +22,24 @@ def _truth_fields(T=6, order=None):
     if order is not None:
         names, joints, ang = names[order], joints[:, order], ang[:, order]
     return dict(
-        fps=25.0, times=np.arange(T) / 25.0, joint_names=names, joints=joints, angles=ang, root=root,
-        landmarks3d=np.zeros((T, 33, 3)), keypoints=np.zeros((T, 33, 2)), visibility=np.ones((T, 33)),
-        K=np.eye(3), R=np.eye(3), t=np.zeros(3), image_size=np.array([64, 48]), score="{}", effort="{}",
-        view="front", style="stick", body_height=1.65,
+        fps=25.0,
+        times=np.arange(T) / 25.0,
+        joint_names=names,
+        joints=joints,
+        angles=ang,
+        root=root,
+        landmarks3d=np.zeros((T, 33, 3)),
+        keypoints=np.zeros((T, 33, 2)),
+        visibility=np.ones((T, 33)),
+        K=np.eye(3),
+        R=np.eye(3),
+        t=np.zeros(3),
+        image_size=np.array([64, 48]),
+        score="{}",
+        effort="{}",
+        view="front",
+        style="stick",
+        body_height=1.65,
     )
 
 
@@ -65,13 +79,15 @@ def test_normalise_world_moves_floor_origin_and_facing():
     root = np.tile(body.rest[0] + [1.0, 2.0, 0.3], (T, 1))
     pts = forward_kinematics(ang, root, body)
     out, (extra,) = normalise_world(pts, np.ones(pts.shape[:2]), [pts[:, 0]])
-    np.testing.assert_allclose(out, forward_kinematics(np.zeros_like(ang), np.tile(body.rest[0], (T, 1)), body), atol=1e-9)
+    np.testing.assert_allclose(
+        out, forward_kinematics(np.zeros_like(ang), np.tile(body.rest[0], (T, 1)), body), atol=1e-9
+    )
     np.testing.assert_allclose(extra, out[:, 0])
 
 
 def test_unknown_and_missing_files_are_reported(tmp_path):
     (tmp_path / "take.trc").write_text("x")
-    with pytest.raises(MotionFileError, match="unknown motion file type '.trc'"):
+    with pytest.raises(MotionFileError, match=r"unknown motion file type '\.trc'"):
         read_motion(tmp_path / "take.trc")
     with pytest.raises(MotionFileError, match="no such motion file"):
         read_motion(tmp_path / "absent.bvh")

@@ -1,6 +1,6 @@
 """Reference motions with known Effort, for tests and calibration.
 
-A minimal stand-in for the virtual dancer: the body stands at rest and one
+The smallest dancer: the body stands at rest and one
 straight arm (or leg) swings between symbol directions, its direction
 slerped with the logistic progress ``s(τ)`` and its distance from the bound
 joint modulated by Space (eq. 5.5).  It is exact by construction, so it tests
@@ -13,19 +13,26 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..body import Body, joint_index
-from ..errors import EffortError
-from ..notation.directions import canonical_vector
-from ..notation.model import PART_SEGMENTS, SUPPORT_PARTS, Effort, Score, Symbol
-from .model import progress, space_radius
+from capture2notation.body import Body, joint_index
+from capture2notation.errors import SyntheticError
+from capture2notation.notation.directions import canonical_vector
+from capture2notation.notation.effort import progress, space_radius
+from capture2notation.notation.model import PART_SEGMENTS, SUPPORT_PARTS, Effort, Score, Symbol
 
 __all__ = ["arc_motion", "random_arm_score"]
 
 #: Targets for random arm symbols (direction, level), all different vectors.
 _TARGETS = (
-    ("forward", "middle"), ("right", "middle"), ("forward", "high"), ("right", "high"),
-    ("right_forward", "middle"), ("forward", "low"), ("right", "low"), ("place", "high"),
-    ("right_back", "middle"), ("right_forward", "high"),
+    ("forward", "middle"),
+    ("right", "middle"),
+    ("forward", "high"),
+    ("right", "high"),
+    ("right_forward", "middle"),
+    ("forward", "low"),
+    ("right", "low"),
+    ("place", "high"),
+    ("right_back", "middle"),
+    ("right_forward", "high"),
 )
 
 
@@ -84,7 +91,7 @@ def arc_motion(
     joints = np.repeat(body.rest[None], n, axis=0)
     for part in sorted({s.part for s in score.symbols} - set(SUPPORT_PARTS)):
         if part not in ("right_arm", "left_arm", "right_leg", "left_leg"):
-            raise EffortError(f"arc_motion moves whole arms and legs only, not {part}")
+            raise SyntheticError(f"arc_motion moves whole arms and legs only, not {part}")
         bound, free = (joint_index(j) for j in PART_SEGMENTS[part])
         mid = joint_index(PART_SEGMENTS[part][1].replace("wrist", "elbow").replace("ankle", "knee"))
         length = float(np.linalg.norm(body.rest[free] - body.rest[bound]))
@@ -108,4 +115,3 @@ def arc_motion(
         # elbow/knee on the line (its distance changes with the bend Space implies)
         joints[:, mid] = joints[:, bound] + 0.5 * r[:, None] * u
     return joints
-

@@ -9,9 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from capture2notation.errors import CompareError
-from capture2notation.notation.model import Score, Symbol
-from capture2notation.quantise.agreement import (
+from capture2notation.compare.agreement import (
     agreement_cells,
     at_tempo,
     compare_scores,
@@ -21,6 +19,8 @@ from capture2notation.quantise.agreement import (
     state_at,
     symbol_agreement,
 )
+from capture2notation.errors import CompareError
+from capture2notation.notation.model import Score, Symbol
 
 REF = Score(
     symbols=(
@@ -50,7 +50,9 @@ def test_normal_form_drops_no_ops():
         tempo=60,
     )
     assert [(s.start, s.part) for s in normalise(steps).symbols] == [
-        (0, "right_support"), (2, "right_support"), (3, "support")
+        (0, "right_support"),
+        (2, "right_support"),
+        (3, "support"),
     ]
 
 
@@ -60,13 +62,20 @@ def test_identical_scores_agree_fully():
 
 
 def test_agreement_cells_name_what_the_agreement_misses():
-    cand = Score(symbols=(Symbol(1, 1, "right_arm", "forward", "middle"),
-                          Symbol(2, 2, "right_arm", "right", "middle", bend=1),
-                          Symbol(1, 2, "head", "forward", "high")), tempo=60)
+    cand = Score(
+        symbols=(
+            Symbol(1, 1, "right_arm", "forward", "middle"),
+            Symbol(2, 2, "right_arm", "right", "middle", bend=1),
+            Symbol(1, 2, "head", "forward", "high"),
+        ),
+        tempo=60,
+    )
     cells = agreement_cells(REF, cand)
     wrong = [(c.part, c.beat, c.ref, c.cand) for c in cells if c.ref != c.cand]
-    assert wrong == [("right_arm", F(5, 2), ("right", "high"), ("right", "middle")),
-                     ("right_arm", F(7, 2), ("right", "high"), ("right", "middle"))]
+    assert wrong == [
+        ("right_arm", F(5, 2), ("right", "high"), ("right", "middle")),
+        ("right_arm", F(7, 2), ("right", "high"), ("right", "middle")),
+    ]
     assert symbol_agreement(REF, cand) == pytest.approx(1 - len(wrong) / len(cells))
 
 
@@ -74,24 +83,33 @@ def test_limb_and_segment_states_follow_each_other():
     # A bent knee at beat 1, then the straight whole leg at beat 2: from beat 2
     # the shin points the leg's way again, and the leg's own state at beat 1
     # is the direction of hip → ankle with the shin bent back.
-    score = normalise(Score(
-        symbols=(
-            Symbol(0, 1, "right_leg", "right", "low"),
-            Symbol(1, 1, "right_shin", "back", "low"),
-            Symbol(2, 1, "right_leg", "forward", "low"),
-        ),
-        tempo=60,
-    ))
+    score = normalise(
+        Score(
+            symbols=(
+                Symbol(0, 1, "right_leg", "right", "low"),
+                Symbol(1, 1, "right_shin", "back", "low"),
+                Symbol(2, 1, "right_leg", "forward", "low"),
+            ),
+            tempo=60,
+        )
+    )
     beats = [F(1, 2), F(3, 2), F(5, 2)]
     assert state_at(score, "right_shin", beats) == [("right", "low"), ("back", "low"), ("forward", "low")]
     assert state_at(score, "right_thigh", beats) == [("right", "low")] * 2 + [("forward", "low")]
     assert state_at(score, "right_leg", beats) == [("right", "low"), ("right_back", "low"), ("forward", "low")]
     # The same movement written as segments or as the whole straight limb agrees.
-    split = Score(symbols=(Symbol(0, 1, "right_thigh", "right", "low"), Symbol(0, 1, "right_shin", "right", "low"),
-                           Symbol(1, 1, "right_upper_arm", "forward", "middle"),
-                           Symbol(1, 1, "right_forearm", "forward", "middle")), tempo=60)
-    whole = Score(symbols=(Symbol(0, 1, "right_leg", "right", "low"), Symbol(1, 1, "right_arm", "forward", "middle")),
-                  tempo=60)
+    split = Score(
+        symbols=(
+            Symbol(0, 1, "right_thigh", "right", "low"),
+            Symbol(0, 1, "right_shin", "right", "low"),
+            Symbol(1, 1, "right_upper_arm", "forward", "middle"),
+            Symbol(1, 1, "right_forearm", "forward", "middle"),
+        ),
+        tempo=60,
+    )
+    whole = Score(
+        symbols=(Symbol(0, 1, "right_leg", "right", "low"), Symbol(1, 1, "right_arm", "forward", "middle")), tempo=60
+    )
     assert symbol_agreement(whole, split) == 1.0
     # A stray forearm symbol is one wrong arm cell per beat, not an arm and a forearm column.
     ref = whole.replace(symbols=whole.symbols + (Symbol(2, 1, "right_leg", "place", "low"),))
@@ -185,13 +203,18 @@ def test_agreement_is_in_time_not_in_beats(score, ratio):
 def test_agreement_samples_reference_beats():
     """A candidate at twice the tempo with one symbol a candidate beat late is
     half a reference beat late: it costs the reference-beat cells it covers."""
-    ref = Score(symbols=(Symbol(1, 1, "right_arm", "forward", "middle"), Symbol(3, 1, "right_arm", "right", "middle")),
-                tempo=60)
-    cand = Score(symbols=(Symbol(2, 2, "right_arm", "forward", "middle"), Symbol(6, 2, "right_arm", "right", "middle")),
-                 tempo=120)
+    ref = Score(
+        symbols=(Symbol(1, 1, "right_arm", "forward", "middle"), Symbol(3, 1, "right_arm", "right", "middle")), tempo=60
+    )
+    cand = Score(
+        symbols=(Symbol(2, 2, "right_arm", "forward", "middle"), Symbol(6, 2, "right_arm", "right", "middle")),
+        tempo=120,
+    )
     assert compare_scores(ref, cand).exact
-    late = Score(symbols=(Symbol(3, 2, "right_arm", "forward", "middle"), Symbol(6, 2, "right_arm", "right", "middle")),
-                 tempo=120)
+    late = Score(
+        symbols=(Symbol(3, 2, "right_arm", "forward", "middle"), Symbol(6, 2, "right_arm", "right", "middle")),
+        tempo=120,
+    )
     a = compare_scores(ref, late)
     # Sampled at the centres of reference beats 0..3 (0.5, 1.5, …) the late
     # start at 1.5 is in time; per half beat, the cell 1-1.5 differs.

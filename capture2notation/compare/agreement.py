@@ -31,6 +31,7 @@ fractions), and every figure below is in reference beats.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -46,17 +47,17 @@ __all__ = [
     "Cell",
     "agreement_cells",
     "at_tempo",
+    "compare_scores",
     "normalise",
+    "score_differences",
+    "start_errors",
     "state_at",
     "symbol_agreement",
-    "start_errors",
-    "compare_scores",
-    "score_differences",
 ]
 
 #: Starting pose (DESIGN.md): limbs hang straight, head and chest upright,
 #: both feet support at middle level.
-DEFAULT_STATE = {p: ("place", "low", 0) for p in GESTURE_PARTS}
+DEFAULT_STATE: dict[str, tuple] = dict.fromkeys(GESTURE_PARTS, ("place", "low", 0))
 DEFAULT_STATE.update({"head": ("place", "high", 0), "chest": ("place", "high", 0)})
 #: The support column: standing on both feet, in place, middle level.
 DEFAULT_SUPPORT = ("support", "place", "middle")
@@ -110,7 +111,7 @@ def _support_transitions(symbols) -> list:
 
 def normalise(score: Score) -> Score:
     """The normal form of `score` used for comparison (see module docstring)."""
-    state = dict(DEFAULT_STATE)
+    state: dict[str, tuple | None] = dict(DEFAULT_STATE)
     out: list[Symbol] = []
     support = DEFAULT_SUPPORT
     for s in sorted(_support_transitions(_join_straight_limbs(score.symbols)), key=Symbol.sort_key):
@@ -185,6 +186,7 @@ def state_at(score: Score, part: str, beats) -> list[tuple]:
         (direction, level) — (part, direction, level) for ``supports`` — of
         the last symbol that has started at each beat, else the default.
     """
+    cur: tuple
     if part == "supports":
         syms = [s for s in score.symbols if s.is_support]
         cur = DEFAULT_SUPPORT
@@ -219,7 +221,7 @@ def _limb_state(limb: str, segs: dict) -> tuple[str, str]:
 
 def _family() -> dict[str, tuple[str, ...]]:
     """Parts whose symbols set each part's state: the part first, then the rest of its limb."""
-    fam = {}
+    fam: dict[str, tuple[str, ...]] = {}
     for limb, (up, low) in _SEGMENTS.items():
         fam[limb] = (limb, up, low)
         fam[up] = (limb, up)
@@ -232,8 +234,14 @@ def _limb_lengths() -> dict[str, tuple[float, float]]:
 
     lengths = np.linalg.norm(Body().offsets, axis=1)
     ends = {"arm": ("elbow", "wrist"), "leg": ("knee", "ankle")}
-    return {f"{side}_{limb}": tuple(float(lengths[joint_index(f"{side}_{j}")]) for j in ends[limb])
-            for side in ("right", "left") for limb in ends}
+    return {
+        f"{side}_{limb}": (
+            float(lengths[joint_index(f"{side}_{ends[limb][0]}")]),
+            float(lengths[joint_index(f"{side}_{ends[limb][1]}")]),
+        )
+        for side in ("right", "left")
+        for limb in ends
+    }
 
 
 _FAMILY = _family()
@@ -295,12 +303,15 @@ def agreement_cells(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> li
     """
     ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
     end = max(ref.duration, cand.duration)
-    n = int(np.ceil(end / step)) if end > 0 else 0
+    n = math.ceil(end / step) if end > 0 else 0
     # Cell centres: a symbol starting a frame late (or a tempo a bpm off)
     # does not lose its whole cell; start errors are reported on their own.
     beats = [(k + Fraction(1, 2)) * step for k in range(n)]
-    return [Cell(p, b, x, y) for p in _parts(ref, cand)
-            for b, x, y in zip(beats, state_at(ref, p, beats), state_at(cand, p, beats))]
+    return [
+        Cell(p, b, x, y)
+        for p in _parts(ref, cand)
+        for b, x, y in zip(beats, state_at(ref, p, beats), state_at(cand, p, beats))
+    ]
 
 
 def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> float:
@@ -398,7 +409,9 @@ def compare_scores(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> Agr
     Agreement
     """
     if not isinstance(ref, Score) or not isinstance(cand, Score):
-        raise CompareError(f"compare_scores needs two Score objects, got {type(ref).__name__} and {type(cand).__name__}")
+        raise CompareError(
+            f"compare_scores needs two Score objects, got {type(ref).__name__} and {type(cand).__name__}"
+        )
     errs, missing = start_errors(ref, cand)
     return Agreement(
         symbol_agreement=symbol_agreement(ref, cand, step),
@@ -439,6 +452,4 @@ def score_differences(ref: Score, cand: Score, supports: bool = True) -> list[st
         start, dur, part, d, lv, bend = k
         return f"{start} {dur} {part} {d} {lv}" + (f" bend={bend}" if bend else "")
 
-    return [f"missing: {fmt(k)}" for k in sorted(a - b, key=str)] + [
-        f"extra: {fmt(k)}" for k in sorted(b - a, key=str)
-    ]
+    return [f"missing: {fmt(k)}" for k in sorted(a - b, key=str)] + [f"extra: {fmt(k)}" for k in sorted(b - a, key=str)]
