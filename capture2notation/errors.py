@@ -9,6 +9,7 @@ from __future__ import annotations
 __all__ = [
     "BodyModelError",
     "C2NError",
+    "CalibrationError",
     "CompareError",
     "EffortError",
     "FittingError",
@@ -81,6 +82,10 @@ class KeypointError(C2NError):
 
 class MotionFileError(C2NError):
     """A BVH, Kinect CSV or truth sidecar that cannot be read."""
+
+
+class CalibrationError(C2NError):
+    """A camera calibration that cannot be read, made or used (file, board, cameras)."""
 
 
 class FittingError(C2NError):
