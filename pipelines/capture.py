@@ -29,8 +29,12 @@ from __future__ import annotations
 import html
 import json
 import logging
+import os
+import shutil
+import tempfile
 import time
-from dataclasses import dataclass, field
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -232,7 +236,6 @@ def capture(
     _check_options(backend, tempo, fps_override)
     kind = input_kind(input_path)
     outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
     motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress, flip_test)
     joints = np.asarray(motion.joints, dtype=float)
     fps = float(motion.fps)
@@ -245,19 +248,48 @@ def capture(
     seconds["quantise"] = time.perf_counter() - t0
     if seg.tempo_estimated:
         log.info("capture: estimated tempo %s bpm%s", seg.tempo, tempo_note(seg, kind))
-    files, skipped = _write_outputs(outdir, seg, motion, track, input_path, kind, overlay)
-    if effort:
-        t0 = time.perf_counter()
-        try:
-            files.update(_write_effort(outdir, seg.score, motion, seed))
-        except C2NError as exc:
-            # Effort is an addition to the notation: report, keep the rest.
-            skipped.append(f"effort.json: {exc}")
-            log.warning("capture: effort not estimated: %s", exc)
-        seconds["effort"] = time.perf_counter() - t0
-    result = CaptureResult(outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped))
-    files["index.html"] = write_text(outdir / "index.html", index_html(result))
-    return result
+    with _staging(outdir) as stage:
+        files, skipped = _write_outputs(stage, seg, motion, track, input_path, kind, overlay)
+        if effort:
+            t0 = time.perf_counter()
+            try:
+                files.update(_write_effort(stage, seg.score, motion, seed))
+            except C2NError as exc:
+                # Effort is an addition to the notation: report, keep the rest.
+                skipped.append(f"effort.json: {exc}")
+                log.warning("capture: effort not estimated: %s", exc)
+            seconds["effort"] = time.perf_counter() - t0
+        staged = CaptureResult(outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped))
+        files["index.html"] = write_text(stage / "index.html", index_html(staged))
+        files = {name: outdir / Path(p).relative_to(stage) for name, p in files.items()}
+    return replace(staged, files=files)
+
+
+@contextmanager
+def _staging(outdir: Path):
+    """A hidden folder beside `outdir` to write into; its files move into `outdir` only on success.
+
+    A capture that fails part-way leaves neither an empty `outdir` nor a mix
+    of new and old files in an existing one.
+    """
+    anchor = outdir.absolute().parent
+    while not anchor.exists():
+        anchor = anchor.parent
+    try:
+        stage = Path(tempfile.mkdtemp(dir=anchor, prefix=f".{outdir.name}.partial-"))
+    except OSError as exc:
+        raise PipelineError(f"{outdir}: cannot write in {anchor} ({exc.strerror})") from None
+    try:
+        yield stage
+        outdir.mkdir(parents=True, exist_ok=True)
+        for src in sorted(stage.rglob("*")):
+            dst = outdir / src.relative_to(stage)
+            if src.is_dir():
+                dst.mkdir(exist_ok=True)
+            else:
+                os.replace(src, dst)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 def _write_outputs(outdir: Path, seg: Segmentation, motion, track, input_path, kind: str, overlay: bool):

@@ -6,6 +6,22 @@ Effort), a capture directory (``capture.npz`` + ``score.lab`` +
 The two are aligned (tempo scaling when both are scores, dynamic time
 warping on limb directions otherwise), compared movement by movement, and
 summarised in ``summary.json`` and ``report.html``.
+
+What the figures mean:
+
+* A movement *agrees* when the candidate's limb, at the frame aligned to the
+  reference's key pose, lies in the same Labanotation direction and level as
+  the reference's own limb there (both read with DESIGN.md's thresholds);
+  so a performance against itself agrees everywhere, whatever its notation.
+* The warping (:func:`~capture2notation.compare.align.align_performances`)
+  matches a movement only near its own time; reference movements outside the
+  matched stretch are ``missing``, and candidate time matched to nothing
+  counts against: ``symbol_agreement`` = agreeing movements / (reference
+  movements + the movements the reference would have made in the
+  candidate's unmatched time, at the reference's rate).
+* ``same_piece`` is the verdict: agreement beyond what chance gives these
+  two performances (Cohen's κ against the candidate's own pose frequencies,
+  with a one-sided Poisson-binomial test), over most of both performances.
 """
 
 from __future__ import annotations
@@ -19,7 +35,8 @@ import numpy as np
 
 from capture2notation.atomic import write_text
 from capture2notation.body import JOINTS, PARENT, joint_index
-from capture2notation.compare.align import align_dtw, align_tempo
+from capture2notation.compare.align import align_performances, align_tempo
+from capture2notation.compare.chance import chance_of_agreeing, same_piece
 from capture2notation.compare.metrics import (
     agreement_by_part,
     compare_movements,
@@ -30,7 +47,8 @@ from capture2notation.compare.metrics import (
 )
 from capture2notation.compare.stats import sign_test, signs_from_differences
 from capture2notation.errors import PipelineError
-from capture2notation.notation.model import Score
+from capture2notation.notation.directions import classify_indices
+from capture2notation.notation.model import DIRECTIONS, Score
 
 __all__ = ["Side", "compare_sides", "load_side", "run_score"]
 
@@ -142,7 +160,12 @@ def load_side(path, fps: float = 25.0) -> Side:
         if effort is None and score is not None:
             effort = _score_effort(score)
         return Side(str(path), "truth", np.asarray(m.joints, float), float(m.fps), score, effort)
+    from pipelines.commands.options import score_format_or_fail
+
+    score_format_or_fail(p, "a capture folder, a .bvh, a Kinect .csv, a truth .npz")
     score = formats.read(p)
+    if not score.symbols:
+        raise PipelineError(f"{p}: the score has no symbols: there is no performance to compare")
     from synthetic.interpret import interpret
 
     motion = interpret(score, fps=fps)
@@ -173,8 +196,9 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
     -------
     dict
         ``alignment``, ``movements`` (list of MovementResult), per-part
-        agreement, frame errors, Effort differences, sign tests and the
-        aligned joint arrays for plotting (``_ref``, ``_cand``).
+        agreement, frame errors, Effort differences, sign tests, the matched
+        time (``time``) and the ``verdict`` (:class:`~capture2notation.compare.chance.Verdict`),
+        and the aligned joint arrays for plotting (``_ref``, ``_cand``).
     """
     fps = ref.fps
     cj = _resample(cand.joints, cand.fps, fps)
@@ -187,7 +211,7 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
         log.info("reference has no notation; segmented it into %d symbols", len(ref_score.symbols))
     if not ref_score.symbols:
         raise PipelineError(f"{ref.label}: the reference has no movements to compare")
-    dtw_al = align_dtw(rj, _fill_unseen(cj))
+    dtw_al = align_performances(_fill_unseen(rj, ref.label), _fill_unseen(cj, cand.label), fps)
     if cand.kind == "score" and ref.kind == "score":
         pose_al = align_tempo(len(rj), len(cj), float(ref_score.tempo), float(cand.score.tempo), fps, fps)
     else:
@@ -195,21 +219,27 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
     from capture2notation.compare.metrics import key_frames
 
     kf = key_frames(ref_score, fps, len(rj))
+    # Two scores share their beats: the tempo alignment gives the arrivals too.
+    arrival_al = pose_al if pose_al.method == "tempo" else dtw_al
     moves = compare_movements(
         ref_score,
         rj,
         cj,
         pose_al.candidate_frame(kf),
-        dtw_al.candidate_frame(kf),
+        arrival_al.candidate_frame(kf),
         fps,
         fps,
         timing_tolerance=timing_tolerance,
+        against="reference",
     )
+    # A reference movement outside the matched stretch has no counterpart.
+    inside = pose_al.matched(kf)
+    moves = [m if inside[i] or m.verdict == "n/a" else _missing(m) for i, m in enumerate(moves)]
     pairs = pose_al.path
     r_al, c_al = rj[pairs[:, 0]], cj[pairs[:, 1]]
     frame_mpjpe = mpjpe(_centred(r_al), _centred(c_al))
     frame_pa = pa_mpjpe(r_al, c_al)
-    gest = [m for m in moves if m.verdict != "n/a"]
+    gest = [m for m in moves if m.verdict not in ("n/a", "missing")]
     # Elevation (deg) of each moved limb at its key pose, both sides, for the "higher?" question.
     elev = []
     for m in gest:
@@ -225,6 +255,14 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
         ),
     ]
     eff = effort_differences(cand.effort, ref.effort) if cand.effort and ref.effort else {}
+    time = _matched_time(pose_al, fps)
+    chance = _chance(gest, cj, pose_al.cand_span)
+    verdict = same_piece(
+        [m.agree for m in gest],
+        chance,
+        time["matched_reference_s"] / time["reference_s"],
+        time["matched_candidate_s"] / time["candidate_s"],
+    )
     return {
         "alignment": pose_al,
         "dtw": dtw_al,
@@ -235,18 +273,67 @@ def compare_sides(cand: Side, ref: Side, timing_tolerance: float = 0.2) -> dict:
         "pa_mpjpe_mm": 1000 * frame_pa,
         "effort": eff,
         "sign_tests": tests,
+        "time": time,
+        "verdict": verdict,
         "_ref": rj,
         "_cand": cj,
     }
 
 
-def _fill_unseen(j: np.ndarray) -> np.ndarray:
+def _missing(m):
+    from dataclasses import replace
+
+    nan = float("nan")
+    return replace(
+        m,
+        agree=False,
+        verdict="missing",
+        cand_frame=-1,
+        cand_direction="",
+        cand_level="",
+        cand_bend=-1,
+        angle_error=nan,
+        pose_error=nan,
+        timing_offset=nan,
+    )
+
+
+def _matched_time(al, fps: float) -> dict:
+    """Seconds of each performance, and of each matched to the other (frames count 1/fps each)."""
+    r0, r1 = al.ref_span
+    c0, c1 = al.cand_span
+    return {
+        "reference_s": al.n_ref / fps,
+        "candidate_s": al.n_cand / fps,
+        "matched_reference_s": (r1 - r0 + 1) / fps,
+        "matched_candidate_s": (c1 - c0 + 1) / fps,
+    }
+
+
+def _chance(gest, cand_joints: np.ndarray, span: tuple[int, int]) -> np.ndarray:
+    """Each movement's chance of agreeing: the share of matched candidate frames in the reference's class."""
+    if not gest:
+        return np.zeros(0)
+    parts = sorted({m.part for m in gest})
+    di, li = classify_indices(part_vectors(cand_joints[span[0] : span[1] + 1], parts))
+    codes = np.where(di >= 0, 3 * di + li, -1).T  # (P, T)
+    dirs = list(DIRECTIONS)
+    levels = ("high", "middle", "low")
+    target = np.array(
+        [3 * dirs.index(m.ref_direction) + levels.index(m.ref_level) if m.ref_direction else -2 for m in gest]
+    )
+    return chance_of_agreeing(target, codes[[parts.index(m.part) for m in gest]])
+
+
+def _fill_unseen(j: np.ndarray, label: str) -> np.ndarray:
+    """Joints for the alignment only: a joint never seen sits on the pelvis, a frame with
+    gaps holds the last complete frame."""
     out = j.copy()
-    bad = ~np.all(np.isfinite(out), axis=(0, 2))
-    out[:, bad] = out[:, :1]
+    never = ~np.any(np.all(np.isfinite(out), axis=2), axis=0)
+    out[:, never] = out[:, :1]
     nan_frames = ~np.all(np.isfinite(out), axis=(1, 2))
     if nan_frames.all():
-        raise PipelineError("the candidate has no frame with every joint known")
+        raise PipelineError(f"{label}: no frame has every joint known; nothing to align")
     if nan_frames.any():  # hold the last good frame: alignment only, never a measurement
         good = np.flatnonzero(~nan_frames)
         idx = good[np.clip(np.searchsorted(good, np.arange(len(out)), side="right") - 1, 0, None)]
@@ -261,18 +348,29 @@ def summary_dict(cand: Side, ref: Side, res: dict) -> dict:
     verdicts = {}
     for m in moves:
         verdicts[m.verdict] = verdicts.get(m.verdict, 0) + 1
+    timed = [m for m in gest if m.verdict != "missing"]
+    t = res["time"]
+    agreeing = sum(m.agree for m in gest)
+    # Unmatched candidate time counts as the movements the reference makes in that much time.
+    unmatched = (t["candidate_s"] - t["matched_candidate_s"]) / t["reference_s"] * len(gest)
     return {
         "candidate": {"path": cand.label, "kind": cand.kind, "fps": cand.fps, "frames": int(len(cand.joints))},
         "reference": {"path": ref.label, "kind": ref.kind, "fps": ref.fps, "frames": int(len(ref.joints))},
         "alignment": {"method": res["alignment"].method, "dtw_cost": res["dtw"].cost},
-        "symbol_agreement": float(np.mean([m.agree for m in gest])) if gest else None,
+        "symbol_agreement": agreeing / (len(gest) + unmatched) if gest else None,
+        "movements_agreeing": int(agreeing),
+        "movements_compared": len(gest),
+        "movements_missing": int(verdicts.get("missing", 0)),
+        "unmatched_candidate_movements": float(unmatched),
+        "time_s": t,
+        "verdict": res["verdict"].as_dict(),
         "agreement_by_part": res["agreement"],
-        "angle_error_deg": {"mean": float(np.nanmean([m.pose_error for m in gest])) if gest else None},
+        "angle_error_deg": {"mean": float(np.mean([m.pose_error for m in timed])) if timed else None},
         "mpjpe_mm": float(np.nanmean(res["mpjpe_mm"])),
         "pa_mpjpe_mm": float(np.nanmean(res["pa_mpjpe_mm"])),
         "timing_offset_s": {
-            "mean": float(np.mean([m.timing_offset for m in gest])) if gest else None,
-            "mean_abs": float(np.mean([abs(m.timing_offset) for m in gest])) if gest else None,
+            "mean": float(np.mean([m.timing_offset for m in timed])) if timed else None,
+            "mean_abs": float(np.mean([abs(m.timing_offset) for m in timed])) if timed else None,
         },
         "effort_differences": res["effort"],
         "verdicts": verdicts,
@@ -323,7 +421,7 @@ def _key_pose_figure(res: dict, max_poses: int = 8):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    gest = [m for m in res["movements"] if m.verdict != "n/a"]
+    gest = [m for m in res["movements"] if m.verdict not in ("n/a", "missing")]
     if len(gest) > max_poses:
         gest = [gest[i] for i in np.linspace(0, len(gest) - 1, max_poses).round().astype(int)]
     cols = min(4, max(len(gest), 1))
@@ -360,12 +458,18 @@ def write_score_report(cand: Side, ref: Side, res: dict, summ: dict, outdir) -> 
         f"{ref.fps:g} fps), aligned by {summ['alignment']['method']}. Symbol agreement "
         f"{'–' if sa is None else f'{sa:.0%}'}, MPJPE {summ['mpjpe_mm']:.0f} mm (pelvis-centred), "
         f"Procrustes-aligned {summ['pa_mpjpe_mm']:.0f} mm, mean |timing offset| "
-        f"{float('nan') if mean_abs is None else mean_abs:.3f} s."
+        f"{float('nan') if mean_abs is None else mean_abs:.3f} s. "
+        f"{summ['movements_agreeing']} of {summ['movements_compared']} reference movements agree "
+        f"({summ['movements_missing']} have no matched candidate time); "
+        f"{summ['time_s']['matched_candidate_s']:.1f} of the candidate's {summ['time_s']['candidate_s']:.1f} s "
+        "are matched, and the rest counts against the agreement at the reference's rate of movements."
     )
+    rep.heading("Verdict")
+    rep.paragraph(f"{summ['verdict']['reason'][0].upper()}{summ['verdict']['reason'][1:]}.")
     rep.heading("Key poses")
     rep.figure(_key_pose_figure(res), "key_poses", "Stick figures at each key pose of the reference, front view.")
     rep.heading("Errors over the phrase")
-    gest = [m for m in res["movements"] if m.verdict != "n/a"]
+    gest = [m for m in res["movements"] if m.verdict not in ("n/a", "missing")]
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.2))
     t = res["alignment"].path[:, 0] / ref.fps
     axes[0].plot(t, res["mpjpe_mm"], label="MPJPE")
@@ -403,6 +507,8 @@ def write_score_report(cand: Side, ref: Side, res: dict, summ: dict, outdir) -> 
         "part",
         "direction",
         "level",
+        "ref_direction",
+        "ref_level",
         "cand_direction",
         "cand_level",
         "angle_error",

@@ -1,7 +1,7 @@
 """The import graph: layers import one way only, and no module cycle.
 
 Layers, bottom to top (ARCHITECTURE.md): the base modules (``errors``,
-``atomic``) ← body ← notation ← io ← keypoints ← fitting ← quantise ← effort
+``atomic``, ``progress``) ← body ← notation ← io ← keypoints ← fitting ← quantise ← effort
 ← compare, then ``synthetic`` and ``pipelines`` beside each other above the
 library (pipelines may use synthetic for its demo and study; nothing in the
 library imports either).  Every import counts, including those inside
@@ -69,7 +69,7 @@ def _layer(module: str) -> str:
     parts = module.split(".")
     if parts[0] != "capture2notation":
         return parts[0]
-    if len(parts) == 1 or parts[1] in ("errors", "atomic"):
+    if len(parts) == 1 or parts[1] in ("errors", "atomic", "progress"):
         return "base"
     return parts[1]
 

@@ -201,7 +201,8 @@ class MovementResult:
     cand_bend : int
         Candidate bend degree (−1 when not applicable).
     agree : bool
-        Direction and level agree.
+        Direction and level agree (with the notation, or with the
+        reference's own pose when compared ``against="reference"``).
     angle_error : float
         Degrees between the candidate limb and the symbol's canonical vector.
     ref_angle_error : float
@@ -213,7 +214,10 @@ class MovementResult:
         Candidate arrival − reference arrival, seconds.
     verdict : str
         ``match`` (pose and timing), ``late/early`` (pose right, timing off),
-        ``pose`` (wrong symbol), ``n/a`` (supports: not evaluated here).
+        ``pose`` (wrong symbol), ``n/a`` (supports: not evaluated here);
+        ``c2n score`` adds ``missing`` (no candidate time matched to it).
+    ref_direction, ref_level : str
+        The reference's own pose at `ref_frame`, classified ("" when undefined).
     """
 
     index: int
@@ -232,6 +236,8 @@ class MovementResult:
     pose_error: float
     timing_offset: float
     verdict: str
+    ref_direction: str = ""
+    ref_level: str = ""
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -247,6 +253,7 @@ def compare_movements(
     fps_cand: float,
     ref_t0: float = 0.0,
     timing_tolerance: float = 0.2,
+    against: str = "notation",
 ) -> list[MovementResult]:
     """Compare the candidate with every gesture symbol of the reference score.
 
@@ -268,12 +275,22 @@ def compare_movements(
         Time (s) of beat 0 in the reference.
     timing_tolerance : float
         |offset| (s) up to which timing counts as right.
+    against : {"notation", "reference"}
+        What the candidate's pose must agree with: the reference's symbol,
+        or the reference's own pose at its key frame, classified the same
+        way.  The second compares two performances as they are: a captured
+        reference whose joints do not quite hold what its quantised score
+        says (a chest written ``forward middle`` whose key frame is 25°
+        up) then counts against neither side, and a performance against
+        itself agrees exactly.
 
     Returns
     -------
     list of MovementResult
         One per symbol, in score order (supports get verdict ``n/a``).
     """
+    if against not in ("notation", "reference"):
+        raise CompareError(f"against must be 'notation' or 'reference', got {against!r}")
     kf = key_frames(ref_score, fps_ref, len(ref_joints), ref_t0)
     pose_frames = np.clip(np.asarray(pose_frames, dtype=int), 0, len(cand_joints) - 1)
     arrival_frames = np.asarray(arrival_frames, dtype=int)
@@ -314,9 +331,11 @@ def compare_movements(
         p = parts.index(sym.part)
         c = cv[pose_frames[i], p]
         r = rv[kf[i], p]
-        di, li = classify_indices(c[None])
+        di, li = classify_indices(np.stack([c, r]))
         cdir = _DIRS[di[0]] if di[0] >= 0 else ""
         clev = _LEVELS[li[0]] if li[0] >= 0 else ""
+        rdir = _DIRS[di[1]] if di[1] >= 0 else ""
+        rlev = _LEVELS[li[1]] if li[1] >= 0 else ""
         target = canonical_vector(sym.direction, sym.level)
         cbend = -1
         if sym.part in PART_MIDDLE_JOINT:
@@ -324,7 +343,8 @@ def compare_movements(
             m = PART_MIDDLE_JOINT[sym.part]
             j = cand_joints[pose_frames[i]]
             cbend = int(bend_degree(bend_angle(j[joint_index(a)], j[joint_index(m)], j[joint_index(b)])))
-        agree = cdir == sym.direction and clev == sym.level
+        want = (sym.direction, sym.level) if against == "notation" else (rdir, rlev)
+        agree = bool(cdir) and (cdir, clev) == want
         if not agree:
             verdict = "pose"
         elif abs(offset) <= timing_tolerance:
@@ -349,6 +369,8 @@ def compare_movements(
                 float(angle_between(c, r)),
                 offset,
                 verdict,
+                rdir,
+                rlev,
             )
         )
     return out

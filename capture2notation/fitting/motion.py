@@ -90,7 +90,7 @@ def _own_motion(fps, angles, root, offsets) -> MotionData:
         joints=joints,
         angles=angles,
         root=root,
-        confidence=np.ones((T, len(JOINTS))),
+        confidence=np.all(np.isfinite(joints), axis=-1).astype(float),
         offsets=offsets,
         source="bvh",
     )

@@ -25,7 +25,9 @@ our ``Rz Ry Rx`` seen in y-up axes.
 from __future__ import annotations
 
 import logging
+import os
 import re
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,8 +36,10 @@ import numpy as np
 from ..atomic import write_text
 from ..body import JOINTS, Body
 from ..errors import MotionFileError
+from .limits import MAX_ABS_ANGLE_DEG, MAX_ABS_FILE_LENGTH, MAX_FRAMES, MAX_JOINTS, MIN_FPS, check_duration
 
 __all__ = [
+    "CHANNEL_NAMES",
     "NAME_TABLE",
     "BvhSkeleton",
     "bvh_positions",
@@ -130,68 +134,142 @@ class BvhSkeleton:
         return 1.0 / self.frame_time
 
 
-def parse_bvh(path) -> BvhSkeleton:
-    """Parse a BVH file; errors name the file, line and what was expected."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise MotionFileError(f"{path}: cannot read BVH file: {exc.strerror}") from None
-    lines = text.splitlines()
-    tokens = [(tok, i + 1) for i, line in enumerate(lines) for tok in line.split()]
-    pos = 0
+#: The six channel names a BVH joint may list (compared lower-case).
+CHANNEL_NAMES = ("xposition", "yposition", "zposition", "xrotation", "yrotation", "zrotation")
+#: Values of a motion block allocated without first checking that the file
+#: is long enough to hold them (8 MB); smaller blocks are counted as read,
+#: which gives the exact count in the message.
+_SMALL_BLOCK = 1 << 20
+_INTEGER = re.compile(r"^\+?[0-9]+$")
 
-    def take(expect=None):
-        nonlocal pos
-        if pos >= len(tokens):
-            raise MotionFileError(f"{path}: unexpected end of file; expected {expect or 'more data'}")
-        tok, ln = tokens[pos]
+
+class _Tokens:
+    """Whitespace tokens of a BVH hierarchy with their line numbers, read line by line."""
+
+    def __init__(self, fh, path: Path):
+        self.fh = fh
+        self.path = path
+        self.line_no = 0
+        self.buf: deque = deque()
+
+    def _fill(self) -> bool:
+        while not self.buf:
+            raw = self.fh.readline()
+            if not raw:
+                return False
+            self.line_no += 1
+            self.buf.extend((t, self.line_no) for t in raw.decode("utf-8", errors="replace").split())
+        return True
+
+    def peek(self) -> str | None:
+        return self.buf[0][0] if self._fill() else None
+
+    def take(self, expect: str | None = None, what: str | None = None) -> tuple[str, int]:
+        """The next token; it must be `expect` (case-insensitive) when given; `what` names it at end of file."""
+        if not self._fill():
+            raise MotionFileError(
+                f"{self.path}: unexpected end of file; expected {what or (repr(expect) if expect else 'more data')}"
+            )
+        tok, ln = self.buf.popleft()
         if expect is not None and tok.upper() != expect.upper():
-            raise MotionFileError(f"{path}:{ln}: expected {expect!r}, found {tok!r}")
-        pos += 1
+            raise MotionFileError(f"{self.path}:{ln}: expected {expect!r}, found {tok!r}")
         return tok, ln
 
-    def number(what):
-        tok, ln = take()
+    def number(self, what: str, bound: float) -> float:
+        tok, ln = self.take()
         try:
-            return float(tok)
+            value = float(tok)
         except ValueError:
-            raise MotionFileError(f"{path}:{ln}: expected a number for {what}, found {tok!r}") from None
+            raise MotionFileError(f"{self.path}:{ln}: expected a number for {what}, found {tok!r}") from None
+        if not abs(value) <= bound:
+            raise MotionFileError(f"{self.path}:{ln}: {what} is {tok}; expected a finite number within ±{bound:g}")
+        return value
 
-    take("HIERARCHY")
+    def integer(self, what: str, low: int, high: int) -> int:
+        tok, ln = self.take()
+        if not _INTEGER.match(tok) or not low <= int(tok) <= high:
+            raise MotionFileError(f"{self.path}:{ln}: {what} is {tok!r}; expected a whole number from {low} to {high}")
+        return int(tok)
+
+
+def parse_bvh(path) -> BvhSkeleton:
+    """Parse a BVH file; errors name the file, line and what was expected.
+
+    The file is streamed: the motion block goes straight into one array of
+    the declared size, which must fit in what is left of the file (at least
+    two bytes per value), so a header cannot make the reader allocate more
+    than a few times the file's own size.  Frame counts, rates, offsets and
+    channel counts are checked against :mod:`capture2notation.io.limits`.
+
+    Channel values that are not finite numbers, or beyond
+    :data:`~capture2notation.io.limits.MAX_ABS_FILE_LENGTH` (positions) or
+    :data:`~capture2notation.io.limits.MAX_ABS_ANGLE_DEG` (rotations), are
+    read as NaN, so the joint they move and everything below it are missing
+    in that frame (NaN with zero confidence downstream), and one warning
+    names the first of them: exporters write ``nan`` for a lost marker, and
+    the other frames and joints remain good measurements.
+
+    Raises
+    ------
+    MotionFileError
+        Unreadable file, syntax error, or a header value outside the limits.
+    """
+    path = Path(path)
+    try:
+        fh = open(path, "rb")  # noqa: SIM115 - closed below; binary for exact positions
+    except OSError as exc:
+        raise MotionFileError(f"{path}: cannot read BVH file: {exc.strerror}") from None
+    with fh:
+        try:
+            size = os.fstat(fh.fileno()).st_size
+            return _parse(_Tokens(fh, path), size)
+        except OSError as exc:
+            raise MotionFileError(f"{path}: cannot read BVH file: {exc.strerror}") from None
+
+
+def _parse(tk: _Tokens, size: int) -> BvhSkeleton:
+    path = tk.path
+    tk.take("HIERARCHY")
     names: list[str] = []
     parents: list[int] = []
     offsets: list = []
     channels: list = []
     stack: list[int] = []
-    tok, ln = take("ROOT")
+    tk.take("ROOT")
     kind = "ROOT"
     while True:
         if kind in ("ROOT", "JOINT"):
-            name, _ = take()
+            name, _ = tk.take(what=f"a name after {kind}")
         else:  # End Site
-            take("Site")
+            tk.take("Site")
             name = f"{names[stack[-1]]}_End"
-        take("{")
+        _, ln = tk.take("{")
+        if len(names) >= MAX_JOINTS:
+            raise MotionFileError(f"{path}:{ln}: more than {MAX_JOINTS} joints; not one performer's skeleton")
         idx = len(names)
         names.append(name)
         parents.append(stack[-1] if stack else -1)
-        take("OFFSET")
-        offsets.append([number(f"OFFSET of {name}") for _ in range(3)])
-        chans = []
-        if kind != "End" and pos < len(tokens) and tokens[pos][0].upper() == "CHANNELS":
-            take("CHANNELS")
-            n = number(f"CHANNELS count of {name}")
-            for _ in range(int(n)):
-                c, cl = take()
-                if c.lower() not in ("xposition", "yposition", "zposition", "xrotation", "yrotation", "zrotation"):
-                    raise MotionFileError(f"{path}:{cl}: unknown channel {c!r} of joint {name}")
+        tk.take("OFFSET")
+        offsets.append([tk.number(f"OFFSET of {name}", MAX_ABS_FILE_LENGTH) for _ in range(3)])
+        chans: list[str] = []
+        if kind != "End" and (tk.peek() or "").upper() == "CHANNELS":
+            tk.take("CHANNELS")
+            n = tk.integer(f"CHANNELS count of {name}", 0, len(CHANNEL_NAMES))
+            for _ in range(n):
+                c, cl = tk.take(what=f"{n} channel names for {name}")
+                if c.lower() not in CHANNEL_NAMES:
+                    raise MotionFileError(
+                        f"{path}:{cl}: unknown channel {c!r} of joint {name}; expected {n} of "
+                        "Xposition Yposition Zposition Xrotation Yrotation Zrotation"
+                    )
+                if c.lower() in chans:
+                    raise MotionFileError(f"{path}:{cl}: channel {c!r} of joint {name} is listed twice")
                 chans.append(c.lower())
         channels.append(chans)
         stack.append(idx)
         # Children or closing braces.
         while True:
-            tok, ln = take()
+            tok, ln = tk.take(what="JOINT, End Site or '}'")
             up = tok.upper()
             if up == "}":
                 stack.pop()
@@ -206,29 +284,90 @@ def parse_bvh(path) -> BvhSkeleton:
             raise MotionFileError(f"{path}:{ln}: expected JOINT, End Site or '}}', found {tok!r}")
         if not stack:
             break
-    take("MOTION")
-    take("Frames:")
-    n_frames = int(number("Frames"))
-    take("Frame")
-    take("Time:")
-    frame_time = number("Frame Time")
-    if not frame_time > 0:
-        raise MotionFileError(f"{path}: Frame Time must be positive, got {frame_time}")
-    n_ch = sum(len(c) for c in channels)
-    rest = tokens[pos:]
-    try:
-        values = np.array([float(t) for t, _ in rest], dtype=float)
-    except ValueError:
-        bad = next((t, ln) for t, ln in rest if not _is_float(t))
-        raise MotionFileError(f"{path}:{bad[1]}: expected a channel value, found {bad[0]!r}") from None
-    if values.size < n_frames * n_ch:
-        raise MotionFileError(
-            f"{path}: motion block has {values.size} values, expected {n_frames} frames × {n_ch} channels = {n_frames * n_ch}"
-        )
-    if values.size > n_frames * n_ch:
-        log.warning("%s: %d values after the %d declared frames ignored", path, values.size - n_frames * n_ch, n_frames)
-    motion = values[: n_frames * n_ch].reshape(n_frames, n_ch)
+    tk.take("MOTION")
+    tk.take("Frames:")
+    n_frames = tk.integer("Frames", 1, MAX_FRAMES)
+    tk.take("Frame")
+    _, ln = tk.take("Time:")
+    frame_time = tk.number("Frame Time", 1.0 / MIN_FPS)
+    problem = check_duration(n_frames, 1.0 / frame_time) if frame_time > 0 else "it is not positive"
+    if problem is not None:
+        raise MotionFileError(f"{path}:{ln}: Frame Time {frame_time:g} s with {n_frames} frames: {problem}")
+    motion = _read_motion_block(tk, size, n_frames, channels, names)
     return BvhSkeleton(names, np.array(parents), np.array(offsets, float), channels, motion, frame_time)
+
+
+def _read_motion_block(tk: _Tokens, size: int, n_frames: int, channels: list, names: list) -> np.ndarray:
+    """The (T, C) channel values after ``Frame Time``, bad values as NaN (see :func:`parse_bvh`)."""
+    path = tk.path
+    n_ch = sum(len(c) for c in channels)
+    total = n_frames * n_ch
+    left = size - tk.fh.tell() + sum(len(t) + 1 for t, _ in tk.buf)
+    if total > _SMALL_BLOCK and total > (left + 1) // 2:
+        raise MotionFileError(
+            f"{path}: Frames: {n_frames} × {n_ch} channels declares {total} values, "
+            f"but only {max(left, 0)} bytes follow (at least 2 per value)"
+        )
+    bound = np.array(
+        [MAX_ABS_FILE_LENGTH if c.endswith("position") else MAX_ABS_ANGLE_DEG for ch in channels for c in ch]
+    )
+    flat = np.empty(total)
+    k = extra = 0
+    first_bad = None
+
+    def lines():
+        while tk.buf:  # values left on the Frame Time line
+            tok, ln = tk.buf.popleft()
+            yield ln, [tok]
+        for raw in tk.fh:
+            tk.line_no += 1
+            yield tk.line_no, raw.decode("utf-8", errors="replace").split()
+
+    for ln, toks in lines():
+        if not toks:
+            continue
+        take = min(len(toks), total - k)
+        extra += len(toks) - take
+        if take == 0:
+            continue
+        try:
+            vals = np.array(toks[:take], dtype=float)
+        except ValueError:
+            bad = next(t for t in toks[:take] if not _is_float(t))
+            raise MotionFileError(f"{path}:{ln}: expected a channel value, found {bad!r}") from None
+        if first_bad is None:
+            col = (k + np.arange(take)) % n_ch
+            off = ~(np.abs(vals) <= bound[col])
+            if off.any():
+                i = int(np.argmax(off))
+                first_bad = (ln, int(col[i]), toks[i])
+        flat[k : k + take] = vals
+        k += take
+    if k < total:
+        raise MotionFileError(
+            f"{path}: motion block has {k} values, expected {n_frames} frames × {n_ch} channels = {total}"
+        )
+    if extra:
+        log.warning("%s: %d values after the %d declared frames ignored", path, extra, n_frames)
+    motion = flat.reshape(n_frames, n_ch)
+    if first_bad is not None:
+        bad = ~(np.abs(motion) <= bound)
+        motion[bad] = np.nan
+        ln, at, tok = first_bad
+        owner = [(n, c) for n, ch in zip(names, channels) for c in ch][at]
+        log.warning(
+            "%s:%d: %s %s is %s: %d channel values are not finite or out of range; what they move is "
+            "missing (NaN, confidence 0) in %d of %d frames",
+            path,
+            ln,
+            owner[0],
+            owner[1].capitalize(),
+            tok,
+            int(bad.sum()),
+            int(bad.any(axis=1).sum()),
+            n_frames,
+        )
+    return motion
 
 
 def _is_float(t: str) -> bool:
@@ -253,9 +392,25 @@ def _axis_rotation(axis: str, deg: np.ndarray) -> np.ndarray:
     return m
 
 
+#: Frames per forward-kinematics chunk: the per-joint rotations of a chunk
+#: (N, chunk, 3, 3) stay a few MB however long the file is.
+_FK_CHUNK = 4096
+
+
 def bvh_positions(skel: BvhSkeleton) -> np.ndarray:
-    """World positions of every joint and end site, file units and axes, ``(T, N, 3)``."""
+    """World positions of every joint and end site, file units and axes, ``(T, N, 3)``.
+
+    NaN channel values make the joint they move, and every joint below it, NaN.
+    """
     T = skel.motion.shape[0]
+    pos = np.empty((T, len(skel.names), 3))
+    for a in range(0, T, _FK_CHUNK):
+        pos[a : a + _FK_CHUNK] = _positions(skel, skel.motion[a : a + _FK_CHUNK])
+    return pos
+
+
+def _positions(skel: BvhSkeleton, motion: np.ndarray) -> np.ndarray:
+    T = motion.shape[0]
     N = len(skel.names)
     pos = np.zeros((T, N, 3))
     glob = np.zeros((T, N, 3, 3))
@@ -265,7 +420,7 @@ def bvh_positions(skel: BvhSkeleton) -> np.ndarray:
         local_t = np.broadcast_to(skel.offsets[i], (T, 3)).copy()
         rot = np.broadcast_to(np.eye(3), (T, 3, 3)).copy()
         for ch in skel.channels[i]:
-            v = skel.motion[:, col]
+            v = motion[:, col]
             col += 1
             if ch.endswith("position"):
                 local_t[:, "xyz".index(ch[0])] = v
@@ -280,7 +435,7 @@ def bvh_positions(skel: BvhSkeleton) -> np.ndarray:
     return pos
 
 
-def _up_and_unit(pos: np.ndarray, pelvis: int, top: int) -> tuple[np.ndarray, float]:
+def _up_and_unit(pos: np.ndarray, pelvis: int, top: int, where="BVH file") -> tuple[np.ndarray, float]:
     """Rotation from file axes to z-up, and metres per file unit.
 
     Parameters
@@ -291,7 +446,12 @@ def _up_and_unit(pos: np.ndarray, pelvis: int, top: int) -> tuple[np.ndarray, fl
     pelvis, top : int
         Indices of the pelvis and of a point above it (head or neck).
     """
-    up_vec = np.median(pos[:, top] - pos[:, pelvis], axis=0)
+    seen = np.all(np.isfinite(pos[:, [pelvis, top]]), axis=(1, 2))
+    if not seen.any():
+        raise MotionFileError(
+            f"{where}: no frame has both the pelvis and the head or neck: cannot tell which axis is up"
+        )
+    up_vec = np.median(pos[seen, top] - pos[seen, pelvis], axis=0)
     up = int(np.argmax(np.abs(up_vec)))
     sign = 1.0 if up_vec[up] >= 0 else -1.0
     to_z = {
@@ -301,7 +461,7 @@ def _up_and_unit(pos: np.ndarray, pelvis: int, top: int) -> tuple[np.ndarray, fl
     }[up].astype(float)
     if sign < 0:
         to_z = np.diag([1.0, -1.0, -1.0]) @ to_z
-    extent = pos[..., up].max(axis=1) - pos[..., up].min(axis=1)
+    extent = np.nanmax(pos[seen, :, up], axis=1) - np.nanmin(pos[seen, :, up], axis=1)
     height = float(np.percentile(extent, 95))
     unit = min(_UNITS.values(), key=lambda u: abs(np.log(max(height * u, 1e-9) / 1.7)))
     if not 1.2 <= height * unit <= 2.2:
@@ -403,7 +563,7 @@ def read_bvh_points(path, joint_map: dict | None = None, where=None):
             "pass joint_map={source_name: our_name}"
         )
     top = mapping.get("head", mapping.get("head_centre", mapping.get("neck", mapping["right_shoulder"])))
-    to_z, unit = _up_and_unit(pos, mapping["pelvis"], top)
+    to_z, unit = _up_and_unit(pos, mapping["pelvis"], top, path)
     pos = pos @ to_z.T * unit
     _check_head_top(mapping, skel.names, pos, joint_map)
     T = pos.shape[0]
@@ -412,7 +572,7 @@ def read_bvh_points(path, joint_map: dict | None = None, where=None):
     for j, name in enumerate(JOINTS):
         if name in mapping:
             points[:, j] = pos[:, mapping[name]]
-            conf[:, j] = 1.0
+            conf[:, j] = np.all(np.isfinite(points[:, j]), axis=-1)
     head_centre = pos[:, mapping["head_centre"]] if "head_centre" in mapping else None
     return points, conf, head_centre, skel.fps
 

@@ -28,9 +28,11 @@ import numpy as np
 from ..atomic import write_text
 from ..body import JOINTS, joint_index
 from ..errors import MotionFileError
+from .limits import MAX_DURATION_S, MAX_FRAMES, check_duration
 
 __all__ = [
     "KINECT_JOINTS",
+    "KINECT_MAX_RANGE_M",
     "KINECT_TO_JOINT",
     "TRACKING_CONFIDENCE",
     "camera_to_world",
@@ -104,6 +106,11 @@ _TICKS_PER_SECOND = 1e7
 _TICKS_THRESHOLD = 1e7  # LabanEditor: larger timestamps are Kinect ticks
 
 
+#: Metres: the farthest a Kinect v2 coordinate can be (its depth sensor sees
+#: to about 8 m, 4.5 m in its specification); a larger value is corrupt.
+KINECT_MAX_RANGE_M = 10.0
+
+
 def read_kinect_csv(path):
     """Read a Kinect v2 skeleton CSV.
 
@@ -116,66 +123,119 @@ def read_kinect_csv(path):
     times : (T,) ndarray
         Seconds from the first row, on a uniform grid.
     positions : (T, 25, 3) ndarray
-        Camera-space metres; NaN for untracked joints and dropped frames.
+        Camera-space metres; NaN for untracked joints, dropped frames and
+        coordinates that are not finite or beyond :data:`KINECT_MAX_RANGE_M`.
     confidence : (T, 25) ndarray
-        From the tracking state (:data:`TRACKING_CONFIDENCE`).
+        From the tracking state (:data:`TRACKING_CONFIDENCE`); 0 where the position is NaN.
     fps : float
         From the median interval between rows.
+
+    Raises
+    ------
+    MotionFileError
+        A malformed row, a timestamp that is not finite or goes backwards, or
+        a clip outside :mod:`capture2notation.io.limits` (rate, length);
+        the message names the line and the value.
     """
     path = Path(path)
+    stamps: list[float] = []
+    rows: list[np.ndarray] = []
+    lines_of: list[int] = []
     try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+        with open(path, "rb") as fh:
+            for ln, raw in enumerate(fh, 1):
+                line = raw.decode("utf-8", errors="replace")
+                if not line.strip():
+                    continue
+                if len(rows) >= MAX_FRAMES:
+                    raise MotionFileError(f"{path}:{ln}: more than {MAX_FRAMES} rows; longer than any dance this reads")
+                ts, row = _parse_row(line, path, ln)
+                stamps.append(ts)
+                rows.append(row)
+                lines_of.append(ln)
     except OSError as exc:
         raise MotionFileError(f"{path}: cannot read Kinect CSV: {exc.strerror}") from None
-    stamps, rows = [], []
-    for ln, line in enumerate(lines, 1):
-        if not line.strip():
-            continue
-        fields = [f.strip() for f in line.split(",")]
-        if fields and fields[-1] == "":
-            fields = fields[:-1]  # trailing comma
-        if len(fields) < 1 + 4 * _N:
-            raise MotionFileError(
-                f"{path}:{ln}: expected a timestamp and 25 joints x (x, y, z, state) = {1 + 4 * _N} fields, got {len(fields)}"
-            )
-        try:
-            vals = np.array([float(f) for f in fields[: 1 + 4 * _N]])
-        except ValueError:
-            bad = next(f for f in fields if not _is_float(f))
-            raise MotionFileError(
-                f"{path}:{ln}: expected numbers, found {bad!r} (the file has no header line)"
-            ) from None
-        state = vals[1:].reshape(_N, 4)[:, 3]
-        if np.any(~np.isin(state, (0, 1, 2))):
-            j = int(np.nonzero(~np.isin(state, (0, 1, 2)))[0][0])
-            raise MotionFileError(
-                f"{path}:{ln}: tracking state of {KINECT_JOINTS[j]} is {float(state[j]):g}, expected 0, 1 or 2"
-            )
-        stamps.append(vals[0])
-        rows.append(vals[1:].reshape(_N, 4))
     if not rows:
         raise MotionFileError(f"{path}: no skeleton rows")
     ticks = np.asarray(stamps)
     data = np.stack(rows)
+    back = np.nonzero(np.diff(ticks) < 0)[0]
+    if back.size:
+        k = int(back[0])
+        raise MotionFileError(
+            f"{path}:{lines_of[k + 1]}: timestamp {ticks[k + 1]:.15g} is earlier than the "
+            f"{ticks[k]:.15g} of line {lines_of[k]}; rows must be in time order"
+        )
     scale = 1.0 / _TICKS_PER_SECOND if ticks.max() > _TICKS_THRESHOLD else 1e-3
     t = (ticks - ticks[0]) * scale
-    if np.any(np.diff(t) < 0):
-        k = int(np.nonzero(np.diff(t) < 0)[0][0])
-        raise MotionFileError(f"{path}: timestamps go backwards at data row {k + 2}")
+    if t[-1] > MAX_DURATION_S:
+        # Name the row where the clip first runs past the limit.
+        k = int(np.argmax(t > MAX_DURATION_S))
+        raise MotionFileError(
+            f"{path}:{lines_of[k]}: timestamp {ticks[k]:.15g} is {t[k]:.3g} s after the first row; "
+            f"a clip can last at most {MAX_DURATION_S / 3600:g} h"
+        )
     dt = np.diff(t)
     dt = dt[dt > 0]
+    if not dt.size and len(rows) > 1:
+        raise MotionFileError(
+            f"{path}: all {len(rows)} rows have the timestamp {ticks[0]:.15g}; expected increasing times"
+        )
     fps = 1.0 / float(np.median(dt)) if dt.size else 30.0
     idx = np.round(t * fps).astype(int)
     T = int(idx[-1]) + 1
+    problem = check_duration(T, fps)
+    if problem is not None:
+        raise MotionFileError(f"{path}: the rows' timestamps give {problem}")
     pos = np.full((T, _N, 3), np.nan)
     conf = np.zeros((T, _N))
     state = data[..., 3].astype(int)
     c = TRACKING_CONFIDENCE[state]
-    xyz = np.where((state > 0)[..., None], data[..., :3], np.nan)
-    pos[idx], conf[idx] = xyz, c  # a repeated grid slot keeps the later row
+    xyz = data[..., :3]
+    good = (state > 0) & np.all(np.abs(xyz) <= KINECT_MAX_RANGE_M, axis=-1)
+    corrupt = (state > 0) & ~good
+    if corrupt.any():
+        r, j = (int(v[0]) for v in np.nonzero(corrupt))
+        log.warning(
+            "%s:%d: %s is at %s: %d tracked positions are not finite or beyond %g m; read as not tracked",
+            path,
+            lines_of[r],
+            KINECT_JOINTS[j],
+            np.array2string(xyz[r, j], precision=4),
+            int(corrupt.sum()),
+            KINECT_MAX_RANGE_M,
+        )
+    pos[idx] = np.where(good[..., None], xyz, np.nan)  # a repeated grid slot keeps the later row
+    conf[idx] = np.where(good, c, 0.0)
     if len(rows) < T:
         log.info("%s: %d dropped frames left as NaN", path, T - len(np.unique(idx)))
     return np.arange(T) / fps, pos, conf, fps
+
+
+def _parse_row(line: str, path: Path, ln: int) -> tuple[float, np.ndarray]:
+    """(timestamp, (25, 4) joints) of one CSV line."""
+    fields = [f.strip() for f in line.split(",")]
+    if fields and fields[-1] == "":
+        fields = fields[:-1]  # trailing comma
+    if len(fields) < 1 + 4 * _N:
+        raise MotionFileError(
+            f"{path}:{ln}: expected a timestamp and 25 joints x (x, y, z, state) = {1 + 4 * _N} fields, got {len(fields)}"
+        )
+    try:
+        vals = np.array([float(f) for f in fields[: 1 + 4 * _N]])
+    except ValueError:
+        bad = next(f for f in fields if not _is_float(f))
+        raise MotionFileError(f"{path}:{ln}: expected numbers, found {bad!r} (the file has no header line)") from None
+    if not np.isfinite(vals[0]):
+        raise MotionFileError(f"{path}:{ln}: timestamp is {fields[0]!r}; expected a finite number")
+    joints = vals[1:].reshape(_N, 4)
+    state = joints[:, 3]
+    if np.any(~np.isin(state, (0, 1, 2))):
+        j = int(np.nonzero(~np.isin(state, (0, 1, 2)))[0][0])
+        raise MotionFileError(
+            f"{path}:{ln}: tracking state of {KINECT_JOINTS[j]} is {float(state[j]):g}, expected 0, 1 or 2"
+        )
+    return float(vals[0]), joints
 
 
 def _is_float(s: str) -> bool:

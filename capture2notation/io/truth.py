@@ -31,6 +31,7 @@ Stored with ``numpy.savez`` without pickles (strings as unicode arrays).
 from __future__ import annotations
 
 import zipfile
+import zlib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
@@ -38,6 +39,7 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import MotionFileError
+from .limits import MAX_FPS, MAX_FRAMES, MAX_IMAGE_SIDE, MAX_JOINTS, MAX_TRUTH_TEXT, MIN_FPS
 
 __all__ = ["TRUTH_FIELDS", "Truth", "read_truth", "write_truth"]
 
@@ -64,6 +66,13 @@ TRUTH_FIELDS: dict[str, tuple | None] = {
     "body_height": (),
 }
 _TEXT = {"joint_names"} | {k for k, v in TRUTH_FIELDS.items() if v is None}
+#: Largest size each free dimension may have.
+_FREE_LIMITS = {"T": MAX_FRAMES, "J": MAX_JOINTS}
+#: Metres: the body heights :class:`~capture2notation.body.Body` accepts.
+BODY_HEIGHT_RANGE = (0.3, 3.0)
+#: What reading a damaged zip or ``.npy`` member can raise (zlib, zipfile,
+#: numpy's header parser, an encrypted or unsupported member).
+_ZIP_ERRORS = (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, NotImplementedError, RuntimeError)
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,14 +140,100 @@ def _validate(arrays: dict, where: str) -> dict:
                 elif dim != want:
                     raise MotionFileError(f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)}")
         out[name] = arr
-    if not (np.isfinite(out["fps"]) and out["fps"] > 0):
-        raise MotionFileError(f"{where}: field fps must be positive, got {out['fps']}")
-    if not (np.isfinite(out["body_height"]) and out["body_height"] > 0):
-        raise MotionFileError(f"{where}: field body_height must be positive, got {out['body_height']}")
+    for free, limit in _FREE_LIMITS.items():
+        if sizes.get(free, 0) > limit:
+            raise MotionFileError(f"{where}: {free} = {sizes[free]} is more than the {limit} a truth sidecar may hold")
+    for name in _TEXT:
+        longest = max((len(v) for v in np.atleast_1d(out[name]).ravel()), default=0)
+        if longest > MAX_TRUTH_TEXT:
+            raise MotionFileError(f"{where}: field {name} holds {longest} characters, more than {MAX_TRUTH_TEXT}")
+    if not (MIN_FPS <= out["fps"] <= MAX_FPS):
+        raise MotionFileError(
+            f"{where}: field fps is {out['fps']}; expected a frame rate in {MIN_FPS:g}-{MAX_FPS:g} Hz"
+        )
+    lo, hi = BODY_HEIGHT_RANGE
+    if not (lo <= out["body_height"] <= hi):
+        raise MotionFileError(f"{where}: field body_height is {out['body_height']}; expected {lo:g}-{hi:g} m")
+    times = out["times"]
+    if not np.all(np.isfinite(times)) or np.any(np.diff(times) < 0):
+        raise MotionFileError(f"{where}: field times must be finite seconds in increasing order")
+    for name in ("K", "R", "t"):
+        if not np.all(np.isfinite(out[name])):
+            raise MotionFileError(f"{where}: field {name} has values that are not finite")
+    size = out["image_size"]
+    if not (np.all(size == np.round(size)) and np.all((size >= 1) & (size <= MAX_IMAGE_SIDE))):
+        raise MotionFileError(
+            f"{where}: field image_size is {size.tolist()}; expected (width, height), whole pixels 1-{MAX_IMAGE_SIDE}"
+        )
     vis = out["visibility"]
     if np.any((vis < 0) | (vis > 1) | np.isnan(vis)):
         raise MotionFileError(f"{where}: field visibility must lie in [0, 1]")
     return out
+
+
+def _load_npz(path: Path) -> dict:
+    """The arrays of a ``.npz``, each member's header checked before its data is read.
+
+    Member shapes must fit :data:`TRUTH_FIELDS` within the limits, so a
+    small file that declares huge arrays is refused without allocating them.
+    """
+    try:
+        zf = zipfile.ZipFile(path)
+    except FileNotFoundError:
+        raise MotionFileError(f"{path}: truth sidecar not found") from None
+    except _ZIP_ERRORS as exc:
+        raise MotionFileError(f"{path}: not a readable truth sidecar (.npz): {exc}") from None
+    arrays = {}
+    with zf:
+        for info in zf.infolist():
+            name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+            if name not in TRUTH_FIELDS or name in arrays:
+                what = "repeated" if name in arrays else "unknown"
+                raise MotionFileError(
+                    f"{path}: {what} truth field {name!r}; expected each of {', '.join(TRUTH_FIELDS)} once"
+                )
+            try:
+                with zf.open(info) as fh:
+                    shape, dtype = _npy_header(fh)
+                    _check_header(name, shape, dtype, str(path))
+                with zf.open(info) as fh:
+                    arrays[name] = np.lib.format.read_array(fh, allow_pickle=False)
+            except MotionFileError:
+                raise
+            except _ZIP_ERRORS as exc:
+                raise MotionFileError(f"{path}: field {name} cannot be read: {exc}") from None
+    return arrays
+
+
+def _npy_header(fh) -> tuple[tuple, np.dtype]:
+    version = np.lib.format.read_magic(fh)
+    if version == (1, 0):
+        shape, _, dtype = np.lib.format.read_array_header_1_0(fh)
+    elif version in ((2, 0), (3, 0)):
+        shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
+    else:
+        raise ValueError(f"unsupported .npy version {version}")
+    return shape, dtype
+
+
+def _check_header(name: str, shape: tuple, dtype: np.dtype, where: str) -> None:
+    """Refuse a member whose declared dtype or size no truth field can have."""
+    text = name in _TEXT
+    if dtype.hasobject or dtype.kind not in ("USa" if text else "biuf"):
+        raise MotionFileError(f"{where}: field {name} has dtype {dtype}, expected {'text' if text else 'numbers'}")
+    pattern = TRUTH_FIELDS[name]
+    if pattern is None:
+        pattern = ()
+    elif name == "joint_names":
+        pattern = ("J",)
+    if len(shape) != len(pattern):
+        raise MotionFileError(f"{where}: field {name} has shape {shape}, expected {_fmt(pattern)}")
+    for dim, want in zip(shape, pattern):
+        limit = _FREE_LIMITS[want] if isinstance(want, str) else want
+        if not 0 <= dim <= limit:
+            raise MotionFileError(f"{where}: field {name} has shape {shape}, expected {_fmt(pattern)} within {limit}")
+    if text and dtype.itemsize > 4 * MAX_TRUTH_TEXT:
+        raise MotionFileError(f"{where}: field {name} is longer than {MAX_TRUTH_TEXT} characters")
 
 
 def _fmt(pattern) -> str:
@@ -180,13 +275,7 @@ def read_truth(path) -> Truth:
         Unreadable file, missing field or wrong shape (names the file and field).
     """
     path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            arrays = {k: npz[k] for k in npz.files}
-    except FileNotFoundError:
-        raise MotionFileError(f"{path}: truth sidecar not found") from None
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-        raise MotionFileError(f"{path}: not a readable truth sidecar (.npz): {exc}") from None
+    arrays = _load_npz(path)
     a = _validate(arrays, str(path))
     kw = {}
     for f in fields(Truth):

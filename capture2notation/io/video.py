@@ -4,8 +4,10 @@ Frames are streamed one at a time, so memory stays constant whatever the
 length.  Timestamps come from the container (``CAP_PROP_POS_MSEC``) when it
 gives increasing values, else from the frame index and frame rate.  A file
 that ends early or has a frame that cannot be decoded yields the frames read
-so far and a :func:`warnings.warn` naming the first bad frame; a file with no
-readable frame raises :class:`~capture2notation.errors.VideoError`.
+so far and a :class:`TruncatedVideoWarning` saying how many frames were read
+and which one failed; a file with no readable frame, or one whose frame rate
+or size no camera has (:mod:`capture2notation.io.limits`), raises
+:class:`~capture2notation.errors.VideoError`.
 """
 
 from __future__ import annotations
@@ -21,11 +23,13 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import VideoError
+from .limits import MAX_FPS, MAX_IMAGE_SIDE
 
 __all__ = [
     "IMAGE_EXTENSIONS",
     "VIDEO_EXTENSIONS",
     "Frame",
+    "TruncatedVideoWarning",
     "VideoInfo",
     "VideoWriter",
     "iter_frames",
@@ -35,6 +39,10 @@ __all__ = [
 VIDEO_EXTENSIONS = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm")
 IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
 DEFAULT_FOLDER_FPS = 30.0
+
+
+class TruncatedVideoWarning(RuntimeWarning):
+    """A video ended, or a frame failed to decode, before its declared length."""
 
 
 @dataclass(frozen=True)
@@ -91,7 +99,10 @@ def _open_capture(path: Path) -> cv2.VideoCapture:
     cap = cv2.VideoCapture(str(path))
     if not cap.isOpened():
         cap.release()
-        raise VideoError(f"{path}: OpenCV cannot open this video; expected an mp4/avi/mov file or an image folder")
+        raise VideoError(
+            f"{path}: OpenCV cannot open this video (not a video, or damaged or cut short); "
+            "expected an mp4/avi/mov file or an image folder"
+        )
     return cap
 
 
@@ -122,22 +133,34 @@ def probe(path, fps: float | None = None) -> VideoInfo:
         if first is None:
             raise VideoError(f"{images[0]}: cannot decode image (frame 0 of folder {path})")
         rate = DEFAULT_FOLDER_FPS if fps is None else float(fps)
-        return VideoInfo(path, rate, len(images), first.shape[1], first.shape[0])
+        return _checked(VideoInfo(path, rate, len(images), first.shape[1], first.shape[0]), "given")
     cap = _open_capture(path)
     try:
         declared = cap.get(cv2.CAP_PROP_FPS)
         rate = float(fps) if fps is not None else float(declared)
-        if not np.isfinite(rate) or rate <= 0:
-            raise VideoError(f"{path}: container declares frame rate {declared!r}; pass fps= explicitly")
-        return VideoInfo(
+        count = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        info = VideoInfo(
             path,
             rate,
-            int(cap.get(cv2.CAP_PROP_FRAME_COUNT)),
+            int(count) if np.isfinite(count) and count > 0 else 0,  # 0: not declared
             int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)),
             int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)),
         )
+        return _checked(info, "given" if fps is not None else "declared by the container")
     finally:
         cap.release()
+
+
+def _checked(info: VideoInfo, whose: str) -> VideoInfo:
+    """`info` if its frame rate and size can be a camera's; a one-line VideoError otherwise."""
+    if not (np.isfinite(info.fps) and 0 < info.fps <= MAX_FPS):
+        raise VideoError(
+            f"{info.path}: frame rate {info.fps!r} ({whose}) is not a video's; expected 0-{MAX_FPS:g} fps "
+            "(give the rate with --fps-override)"
+        )
+    if not (1 <= info.width <= MAX_IMAGE_SIDE and 1 <= info.height <= MAX_IMAGE_SIDE):
+        raise VideoError(f"{info.path}: frame size {info.width}x{info.height} is not a video's (1-{MAX_IMAGE_SIDE} px)")
+    return info
 
 
 def _iter_folder(info: VideoInfo, start: int, stop: int | None) -> Iterator[Frame]:
@@ -157,7 +180,7 @@ def _stop_early(path: Path, index: int, why: str) -> None:
         raise VideoError(f"{path}: no frame could be read: {why}")
     warnings.warn(
         f"{path}: stopped at frame {index} ({why}); using the {index} frames read before it",
-        RuntimeWarning,
+        TruncatedVideoWarning,
         stacklevel=3,
     )
 
@@ -209,9 +232,10 @@ def iter_frames(path, *, fps: float | None = None, start: int = 0, stop: int | N
 
     Warns
     -----
-    RuntimeWarning
+    TruncatedVideoWarning
         The source ends before its declared length or a frame cannot be
-        decoded; the message names the first bad frame.
+        decoded; the message says how many frames were read and names the
+        first bad one.
 
     Raises
     ------

@@ -162,7 +162,7 @@ def extract(
     threads, smooth, markers, estimator, flip_test
         As :func:`extract_frames`.
     progress : bool
-        Show a tqdm progress bar on stderr.
+        Show progress on stderr (a bar on a terminal, else a line every 30 s).
 
     Returns
     -------
@@ -175,10 +175,10 @@ def extract(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, flip_test=flip_test,
         )  # fmt: skip
-    from tqdm import tqdm
+    from ..progress import progress as progress_bar
 
     total = max(0, (info.frame_count if stop is None else min(stop, info.frame_count)) - start) or None
-    with tqdm(total=total, unit="frame", desc=f"keypoints ({backend})") as bar:
+    with progress_bar(total=total, unit="frame", desc=f"keypoints ({backend})") as bar:
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, progress=lambda _i: bar.update(1), flip_test=flip_test,

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import click
 
+from .options import FPS, TEMPO, check_outdir
+
 __all__ = ["capture"]
 
 
@@ -25,8 +27,8 @@ __all__ = ["capture"]
     show_default=True,
     help="Keypoints from a video: the BlazePose model or the renderer's colour markers.",
 )
-@click.option("--tempo", type=float, default=None, help="Beats per minute (default: estimated from the movements).")
-@click.option("--fps-override", type=float, default=None, help="Frame rate to use instead of the input's.")
+@click.option("--tempo", type=TEMPO, default=None, help="Beats per minute (default: estimated from the movements).")
+@click.option("--fps-override", type=FPS, default=None, help="Frame rate to use instead of the input's.")
 @click.option("--grid", default="1/4", show_default=True, help="Beat grid of starts and durations, e.g. 1/4 or 1/2.")
 @click.option("--no-effort", is_flag=True, help="Skip the Laban Effort estimate (the slowest step).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Effort posteriors.")
@@ -49,8 +51,9 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         step = Fraction(grid)
     except (ValueError, ZeroDivisionError):
         raise PipelineError(f"--grid {grid!r} must be a fraction of a beat such as 1/4") from None
-    if step <= 0:
-        raise PipelineError(f"--grid {grid!r} must be > 0 beats")
+    if not 0 < step <= 4:
+        raise PipelineError(f"--grid {grid!r} must be a fraction of a beat in (0, 4]")
+    check_outdir(outdir)
     tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
     result = run(
         input_path,

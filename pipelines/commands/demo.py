@@ -251,9 +251,12 @@ def demo(outdir, phrases, size, view, style, no_effort):
     and compared with the original."""
     from synthetic.render import STYLES, VIEWS
 
+    from .options import check_outdir
+
     wh = parse_size(size)
     check_choice(view, "--view", list(VIEWS))
     check_choice(style, "--style", list(STYLES))
+    check_outdir(outdir)
     names = DEMO_PHRASES if "all" in phrases else tuple(dict.fromkeys(phrases))
     for name in names:
         check_choice(name, "--phrase", [*DEMO_PHRASES, "all"])

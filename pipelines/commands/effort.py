@@ -96,7 +96,9 @@ def run_effort(capture_dir, seed: int = 0, workers: int = 2, plots: bool = True)
 @click.command("effort")
 @click.argument("capture_dir", type=click.Path(exists=True, file_okay=False, path_type=str))
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the emcee runs.")
-@click.option("--workers", type=int, default=2, show_default=True, help="Processes for the posteriors.")
+@click.option(
+    "--workers", type=click.IntRange(1, 256), default=2, show_default=True, help="Processes for the posteriors."
+)
 @click.option("--no-plots", is_flag=True, help="Write effort.json only.")
 def effort(capture_dir, seed, workers, no_plots):
     """Recompute effort.json (and plots) from CAPTURE_DIR/capture.npz and score.lab."""

@@ -24,7 +24,9 @@ __all__ = ["fidelity_study"]
     metavar="ADDRESS",
     help="Run the jobs on a Dask distributed cluster (e.g. tcp://host:8786) instead of local cores.",
 )
-@click.option("--workers", type=int, default=None, help="Local worker processes (default: number of cores).")
+@click.option(
+    "--workers", type=click.IntRange(1, 256), default=None, help="Local worker processes (default: number of cores)."
+)
 @click.option("--seed", type=int, default=None, help="Override the config's seed.")
 @click.option("-o", "--outdir", required=True, type=click.Path(file_okay=False), help="Output folder (resumable).")
 def fidelity_study(config_path, quick, scheduler, workers, seed, outdir):
@@ -36,6 +38,9 @@ def fidelity_study(config_path, quick, scheduler, workers, seed, outdir):
     """
     from pipelines.fidelity import load_config, run_fidelity_study
 
+    from .options import check_outdir
+
+    check_outdir(outdir)
     cfg = load_config(config_path, {"seed": seed} if seed is not None else None)
     t0 = time.perf_counter()
     result = run_fidelity_study(cfg, outdir, is_quick=quick, scheduler=scheduler, workers=workers)

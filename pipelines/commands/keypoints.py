@@ -6,6 +6,8 @@ import click
 
 from capture2notation.keypoints import BACKENDS, extract
 
+from .options import FPS, check_output_file
+
 
 @click.command("keypoints")
 @click.argument("video", type=click.Path(exists=True, path_type=str))
@@ -23,8 +25,8 @@ from capture2notation.keypoints import BACKENDS, extract
     default=None,
     help="ONNX pose model (default: $C2N_POSE_MODEL or the cache).",
 )
-@click.option("--fps", type=float, default=None, help="Frame rate of an image folder (default 30).")
-@click.option("--threads", type=int, default=2, show_default=True, help="onnxruntime threads.")
+@click.option("--fps", type=FPS, default=None, help="Frame rate of an image folder (default 30).")
+@click.option("--threads", type=click.IntRange(1, 256), default=2, show_default=True, help="onnxruntime threads.")
 @click.option("--no-smooth", is_flag=True, help="Disable the one-euro temporal filter.")
 @click.option(
     "--markers",
@@ -41,6 +43,9 @@ from capture2notation.keypoints import BACKENDS, extract
 )
 def keypoints(video, output, backend, overlay, model, fps, threads, no_smooth, markers_file, flip_test):
     """Extract 33 BlazePose keypoints per frame from VIDEO (file or image folder)."""
+    check_output_file(output)
+    if overlay:
+        check_output_file(overlay, "--overlay")
     markers = None
     if markers_file:
         from capture2notation.keypoints.markers import read_marker_specs

@@ -8,6 +8,8 @@ import click
 
 from capture2notation.errors import PipelineError
 
+from .options import FPS, check_outdir, score_format_or_fail
+
 __all__ = ["check_choice", "parse_size", "render"]
 
 _SIZE = re.compile(r"^\s*(\d+)\s*[xX×]\s*(\d+)\s*$")
@@ -47,7 +49,7 @@ def _fps(value: float) -> float:
     type=click.Path(file_okay=False, path_type=str),
     help="Folder to write video.mp4, truth.npz and score.lab into.",
 )
-@click.option("--fps", type=float, default=25.0, show_default=True, help="Frames per second.")
+@click.option("--fps", type=FPS, default=25.0, show_default=True, help="Frames per second.")
 @click.option("--size", default="640x480", show_default=True, help="Image WIDTHxHEIGHT in pixels.")
 @click.option("--view", default="front", show_default=True, help="Camera: front, 45 or side.")
 @click.option("--style", default="mannequin", show_default=True, help="Drawing: mannequin, stick or markers.")
@@ -62,6 +64,8 @@ def render(score, outdir, fps, size, view, style, emotion, png):
 
     wh = parse_size(size)
     _fps(fps)
+    check_outdir(outdir)
+    score_format_or_fail(score)
     check_choice(view, "--view", list(VIEWS))
     check_choice(style, "--style", list(STYLES))
     check_choice(emotion, "--emotion", list(EMOTIONS))

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import click
 
+from .options import FPS, Number, check_outdir
+
+#: Seconds: a timing tolerance longer than a minute tells nothing about timing.
+TIMING_TOLERANCE = Number(0, 60, "seconds")
+
 __all__ = ["score"]
 
 
@@ -13,10 +18,10 @@ __all__ = ["score"]
 @click.option(
     "-o", "--outdir", required=True, type=click.Path(file_okay=False), help="Folder for summary.json and report.html."
 )
-@click.option("--fps", type=float, default=25.0, show_default=True, help="Frame rate at which scores are danced.")
+@click.option("--fps", type=FPS, default=25.0, show_default=True, help="Frame rate at which scores are danced.")
 @click.option(
     "--timing-tolerance",
-    type=float,
+    type=TIMING_TOLERANCE,
     default=0.2,
     show_default=True,
     help="Seconds of timing offset still counted as on time.",
@@ -28,10 +33,15 @@ def score(candidate, reference, outdir, fps, timing_tolerance):
     """
     from pipelines.score import run_score
 
+    check_outdir(outdir)
     s = run_score(candidate, reference, outdir, fps=fps, timing_tolerance=timing_tolerance)
     sa = s["symbol_agreement"]
+    t = s["time_s"]
     click.echo(
-        f"symbol agreement {'n/a' if sa is None else f'{sa:.0%}'}, MPJPE {s['mpjpe_mm']:.0f} mm, "
-        f"PA-MPJPE {s['pa_mpjpe_mm']:.0f} mm; verdicts {s['verdicts']}"
+        f"symbol agreement {'n/a' if sa is None else f'{sa:.0%}'} "
+        f"({s['movements_agreeing']} of {s['movements_compared']} movements agree, {s['movements_missing']} missing; "
+        f"{t['matched_candidate_s']:.1f} of the candidate's {t['candidate_s']:.1f} s matched), "
+        f"MPJPE {s['mpjpe_mm']:.0f} mm, PA-MPJPE {s['pa_mpjpe_mm']:.0f} mm"
     )
+    click.echo(f"verdict: {s['verdict']['reason']}")
     click.echo(f"report: {outdir}/report.html")

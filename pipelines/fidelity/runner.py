@@ -144,10 +144,10 @@ def _cache_path(outdir: Path, job: Job, cfg: StudyConfig, mode: str) -> Path:
 
 def _execute(pending, cfg, mode, scheduler, workers, progress, timeout=20.0):
     """Yield (job, row) as jobs finish, locally or on a Dask cluster."""
-    from tqdm import tqdm
+    from capture2notation.progress import progress as progress_bar
 
     args = [(j, cfg.seed, mode, cfg.source_fps, cfg.bootstrap) for j in pending]
-    bar = tqdm(total=len(args), desc="fidelity study", unit="job", disable=not progress)
+    bar = progress_bar(total=len(args), desc="fidelity study", unit="job", enabled=progress)
     try:
         if scheduler:
             from dask.distributed import Client

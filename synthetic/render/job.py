@@ -123,9 +123,9 @@ def render_pose(
     video = outdir / video_name
     frames = range(len(renderer))
     if progress:
-        from tqdm import tqdm
+        from capture2notation.progress import progress as progress_bar
 
-        frames = tqdm(frames, desc=f"render {style} {view}", unit="frame", leave=False)
+        frames = progress_bar(frames, desc=f"render {style} {view}", unit="frame", leave=False)
     with open_writer(video, pose.fps, camera.size) as writer:
         for i in frames:
             writer.write(renderer.frame(i))

@@ -164,3 +164,63 @@ def test_effort_differences_interval():
     assert (d["time"]["lo"], d["time"]["hi"]) == pytest.approx((-1.1, -0.1))
     assert not d["time"]["consistent"]
     assert d["weight"]["consistent"] is False and d["weight"]["lo"] == pytest.approx(0.05)
+
+
+# --- windowed, open-ended alignment (c2n score) -----------------------------------------------
+
+
+def _phrase_joints(seed=1, beats=12, fps=25.0):
+    from synthetic import random_score
+    from synthetic.interpret import interpret
+
+    return interpret(random_score(np.random.default_rng(seed), n_beats=beats), fps=fps).joints()
+
+
+def test_windowed_alignment_of_a_performance_with_itself_is_the_diagonal():
+    from capture2notation.compare.align import align_performances
+
+    j = _phrase_joints()
+    al = align_performances(j, j, 25.0)
+    np.testing.assert_array_equal(al.path, np.stack([np.arange(len(j))] * 2, axis=1))
+    assert al.cost == 0.0 and al.ref_span == (0, len(j) - 1) and al.cand_span == (0, len(j) - 1)
+
+
+@pytest.mark.parametrize("shift_s", [1.0, -1.0, 1.8])
+def test_windowed_alignment_finds_a_time_shift(shift_s):
+    from capture2notation.compare.align import align_performances
+
+    j = _phrase_joints()
+    k = int(round(abs(shift_s) * 25))
+    cand = np.concatenate([np.repeat(j[:1], k, 0), j]) if shift_s > 0 else j[k:]
+    al = align_performances(j, cand, 25.0)
+    # Every reference frame after the shift lands exactly `k` frames later (earlier).
+    moving = al.path[al.path[:, 0] >= k]
+    np.testing.assert_array_equal(moving[:, 1] - moving[:, 0], np.sign(shift_s) * k)
+
+
+def test_windowed_alignment_cannot_match_a_movement_far_outside_its_time():
+    """The reference's phrase appears in the candidate only after 20 s of standing: far outside
+    the window (2 s + 25 % of the elapsed time), so nothing of it is matched there."""
+    from capture2notation.compare.align import MAX_DRIFT, MAX_LAG_S, align_performances
+
+    j = _phrase_joints()
+    cand = np.concatenate([np.repeat(j[:1], 500, 0), j])
+    al = align_performances(j, cand, 25.0)
+    t_ref, t_cand = al.path[:, 0] / 25.0, al.path[:, 1] / 25.0
+    assert np.all(np.abs(t_cand - t_ref) <= MAX_LAG_S + MAX_DRIFT * t_ref + 1 / 25.0)
+    assert al.cand_span[1] < 500  # the copy of the phrase (frames 500 on) stays unmatched
+
+
+def test_windowed_alignment_decimates_fast_sources_without_moving_the_match():
+    from capture2notation.compare.align import align_performances
+
+    j = _phrase_joints(fps=100.0)
+    cand = np.concatenate([np.repeat(j[:1], 100, 0), j])  # 1 s at 100 Hz
+    al = align_performances(j, cand, 100.0)
+    moving = al.path[al.path[:, 0] >= 100]
+    assert np.all(np.abs(moving[:, 1] - moving[:, 0] - 100) <= 2)  # within the 40-ms decimation
+
+
+def test_tempo_alignment_leaves_beats_the_candidate_never_reaches_unmatched():
+    al = align_tempo(100, 30, ref_tempo=60, cand_tempo=60, fps_ref=25, fps_cand=25)
+    assert al.ref_span == (0, 29) and not al.matched([30])[0] and al.matched([29])[0]

@@ -187,3 +187,106 @@ def test_a_fitted_motion_with_gaps_writes_and_reads_back(tmp_path):
     ok = np.r_[0:4, 5:10]
     np.testing.assert_allclose(m.joints[ok], fit.joints[ok], atol=1e-5)
     np.testing.assert_allclose(m.root[4], fit.root[3], atol=1e-6)  # the gap holds the last root
+
+
+# --- bad input: one-line errors naming the line and the value (issue 16) --------------------------
+
+_MOCAP = "bvh/test_mocapbank.bvh"
+
+
+def _edited(fixture_path, tmp_path, old: str, new: str, name="bad.bvh"):
+    """A copy of the mocapbank fixture with the first `old` replaced by `new`."""
+    text = fixture_path(_MOCAP).read_text()
+    assert old in text
+    path = tmp_path / name
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        ("Frames:\t455", "Frames:\t0", r":118: Frames is '0'; expected a whole number from 1 to 1000000"),
+        ("Frames:\t455", "Frames:\tinf", r":118: Frames is 'inf'"),
+        ("Frames:\t455", "Frames:\tnan", r":118: Frames is 'nan'"),
+        ("Frames:\t455", "Frames:\t-1e308", r":118: Frames is '-1e308'"),
+        ("Frames:\t455", "Frames:\t-1", r":118: Frames is '-1'"),
+        ("Frames:\t455", "Frames:\t2.7", r":118: Frames is '2.7'"),
+        ("Frames:\t455", "Frames:\t456", r"motion block has 27300 values, expected 456 frames"),
+        ("Frame Time:\t0.033333", "Frame Time:\t1e-300", r":119: Frame Time 1e-300 s .*1e\+300 Hz is outside"),
+        ("Frame Time:\t0.033333", "Frame Time:\tnan", r":119: Frame Time is nan"),
+        ("Frame Time:\t0.033333", "Frame Time:\t0", r":119: Frame Time 0 s .*not positive"),
+        ("CHANNELS 3 Zrotation", "CHANNELS nan Zrotation", r":9: CHANNELS count of Chest is 'nan'"),
+        ("CHANNELS 3 Zrotation", "CHANNELS 1e9 Zrotation", r":9: CHANNELS count of Chest is '1e9'"),
+        ("CHANNELS 3 Zrotation Xrotation", "CHANNELS 3 Zrotation Zrotation", r":9: channel 'Zrotation' .* twice"),
+        ("OFFSET -0.1728 10.2870", "OFFSET nan 10.2870", r":8: OFFSET of Chest is nan"),
+        ("OFFSET -0.1728 10.2870", "OFFSET 1e300 10.2870", r":8: OFFSET of Chest is 1e300"),
+    ],
+)
+def test_bad_headers_are_one_line_errors_naming_line_and_value(fixture_path, tmp_path, old, new, message):
+    path = _edited(fixture_path, tmp_path, old, new)
+    with pytest.raises(MotionFileError, match=message) as err:
+        parse_bvh(path)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_declared_frame_count_the_file_cannot_hold_is_refused_before_allocating(tmp_path):
+    # 10⁶ frames × 6 channels would be 48 MB; the file is a few hundred bytes.
+    text = (
+        "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation"
+        " Yrotation\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1000000\nFrame Time: 0.01\n0 0 0 0 0 0\n"
+    )
+    path = tmp_path / "short.bvh"
+    path.write_text(text)
+    with pytest.raises(MotionFileError, match=r"declares 6000000 values, but only 12 bytes follow"):
+        parse_bvh(path)
+
+
+def test_non_finite_channel_values_are_missing_joints_not_nonsense(fixture_path, tmp_path, caplog):
+    """Three NaN/inf values: those joints (and all below them) are NaN with zero confidence in
+    their frames; every other joint and frame reads exactly as in the clean file, and the figure
+    is not rescaled."""
+    text = fixture_path(_MOCAP).read_text().splitlines()
+    m = text.index("MOTION")
+    rows = {k: text[m + 3 + k].split() for k in (0, 47)}
+    rows[0][5] = "nan"  # frame 0: the root's Yrotation -> everything but the root's own position
+    rows[0][10] = "inf"  # frame 0: Chest Xrotation
+    rows[47][7] = "-inf"  # frame 47: Chest Zrotation -> the chest and everything above it
+    for k, r in rows.items():
+        text[m + 3 + k] = " ".join(r)
+    path = tmp_path / "nan3.bvh"
+    path.write_text("\n".join(text) + "\n")
+    with caplog.at_level("WARNING", logger="capture2notation.io.bvh"):
+        bad, bad_conf, _, _ = read_bvh_points(path)
+    warned = [r.getMessage() for r in caplog.records]
+    assert len(warned) == 1 and ":120: Hips Yrotation is nan: 3 channel values" in warned[0]
+    assert "in 2 of 455 frames" in warned[0] and not any("scaled" in w for w in warned)
+    clean, conf, _, _ = read_bvh_points(fixture_path(_MOCAP))
+    pelvis = joint_index("pelvis")
+    assert np.all(np.isnan(np.delete(bad[0], pelvis, 0))) and np.all(np.delete(bad_conf[0], pelvis) == 0)
+    np.testing.assert_array_equal(bad[0, pelvis], clean[0, pelvis])
+    lost = ~np.isfinite(bad[47, :, 0])
+    # The chest moves the neck, head, shoulders and arms; the legs and pelvis stay measured.
+    for name in ("chest", "neck", "left_shoulder", "right_wrist"):
+        assert lost[joint_index(name)], name
+    for name in ("pelvis", "left_hip", "right_ankle"):
+        assert not lost[joint_index(name)], name
+    assert np.all(bad_conf[47, lost] == 0) and np.all(bad_conf[47, ~lost] == conf[47, ~lost])
+    keep = np.r_[1:47, 48:455]
+    np.testing.assert_array_equal(bad[keep], clean[keep])
+    np.testing.assert_array_equal(bad[47, ~lost], clean[47, ~lost])
+
+
+def test_a_motion_file_with_missing_frames_reads_as_a_normal_size_figure(fixture_path, tmp_path):
+    text = fixture_path(_MOCAP).read_text().splitlines()
+    m = text.index("MOTION")
+    row = text[m + 3].split()
+    row[5] = "nan"
+    text[m + 3] = " ".join(row)
+    path = tmp_path / "nan1.bvh"
+    path.write_text("\n".join(text) + "\n")
+    clean = read_motion(fixture_path(_MOCAP))
+    got = read_motion(path)
+    assert np.all(np.delete(got.confidence[0], joint_index("pelvis")) == 0)
+    # Within 3 cm of the clean reading everywhere else (the fit smooths across the gap).
+    np.testing.assert_allclose(got.joints[5:], clean.joints[5:], atol=0.03)

@@ -159,3 +159,63 @@ def test_csv_round_trip_keeps_tracked_values(tmp_path_factory, T, seed):
     np.testing.assert_allclose(got[tracked], pos[tracked], atol=1e-6)
     assert np.all(np.isnan(got[~tracked]))
     np.testing.assert_allclose(conf, np.array([0.0, 0.3, 1.0])[states])
+
+
+# --- bad input: one-line errors naming the line and the value (issue 16) --------------------------
+
+
+def _fixture_with(fixture_path, tmp_path, row: int, field: int, value: str):
+    """The LabanotationSuite fixture with field `field` of data row `row` (0-based) set to `value`."""
+    lines = fixture_path("kinect/joints.csv").read_text().splitlines()
+    cells = lines[row].split(",")
+    cells[field] = value
+    lines[row] = ",".join(cells)
+    path = tmp_path / "bad.csv"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize(
+    "row, value, message",
+    [
+        (5, "nan", r":6: timestamp is 'nan'; expected a finite number"),
+        (5, "inf", r":6: timestamp is 'inf'"),
+        # 10¹⁵ ticks in the middle: the next row goes back in time, and the message shows both values.
+        (5, "1000000000000000", r":7: timestamp 31869373727 is earlier than the 1e\+15 of line 6"),
+        # 10¹⁵ ticks on the last row: 3 years after the first.
+        (-1, "1000000000000000", r":371: timestamp 1e\+15 is 1e\+08 s after the first row; .* at most 6 h"),
+        (0, "-1000000000000000", r":2: timestamp 31867714704 is 1e\+08 s after the first row"),
+    ],
+)
+def test_bad_timestamps_are_one_line_errors(fixture_path, tmp_path, row, value, message):
+    path = _fixture_with(fixture_path, tmp_path, row, 0, value)
+    with pytest.raises(MotionFileError, match=message) as err:
+        read_kinect_csv(path)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+def test_rows_all_at_one_time_are_refused(tmp_path):
+    row = ",".join(["100000000"] + ["0.1", "0.2", "2.0", "2"] * 25)
+    path = tmp_path / "same.csv"
+    path.write_text(f"{row}\n{row}\n")
+    with pytest.raises(MotionFileError, match="all 2 rows have the timestamp 100000000"):
+        read_kinect_csv(path)
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-1e300", "11.0"])
+def test_a_corrupt_tracked_position_is_missing_with_zero_confidence(fixture_path, tmp_path, caplog, value):
+    # Field 5 is SpineMid's x (SpineBase x, y, z, state come first); its state is 2 (tracked).
+    path = _fixture_with(fixture_path, tmp_path, 3, 5, value)
+    with caplog.at_level("WARNING", logger="capture2notation.io.kinect"):
+        _t, pos, conf, _ = read_kinect_csv(path)
+    _t, clean, clean_conf, _ = read_kinect_csv(fixture_path("kinect/joints.csv"))
+    j = KINECT_JOINTS.index("SpineMid")
+    frame = int(np.flatnonzero(np.isnan(pos[:, j, 0]) & np.isfinite(clean[:, j, 0]))[0])
+    assert np.all(np.isnan(pos[frame, j])) and conf[frame, j] == 0
+    keep = np.ones(pos.shape[:2], bool)
+    keep[frame, j] = False
+    np.testing.assert_array_equal(np.nan_to_num(pos[keep], nan=7.0), np.nan_to_num(clean[keep], nan=7.0))
+    np.testing.assert_array_equal(conf[keep], clean_conf[keep])
+    (msg,) = [r.getMessage() for r in caplog.records]
+    assert msg.startswith(f"{path}:4: SpineMid is at [")
+    assert msg.endswith("]: 1 tracked positions are not finite or beyond 10 m; read as not tracked")

@@ -106,3 +106,60 @@ def test_unreadable_file(tmp_path, content):
         path.write_bytes(content)
     with pytest.raises(MotionFileError, match=r"truth\.npz"):
         read_truth(path)
+
+
+# --- bad input: one-line errors naming the field and the value (issue 16) -------------------------
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (lambda f: f.update(fps=np.nan), ["fps is nan", "0.1-1000 Hz"]),
+        (lambda f: f.update(fps=1e9), ["fps is 1000000000.0"]),
+        (lambda f: f.update(body_height=np.inf), ["body_height is inf", "0.3-3 m"]),
+        (lambda f: f.update(times=np.array([0.0, 0.04, np.nan, 0.12, 0.16])), ["times", "finite"]),
+        (lambda f: f.update(times=np.array([0.0, 0.08, 0.04, 0.12, 0.16])), ["times", "increasing"]),
+        (lambda f: f.update(K=np.full((3, 3), np.inf)), ["field K", "not finite"]),
+        (lambda f: f.update(image_size=np.array([640.5, 480])), ["image_size", "whole pixels"]),
+        (lambda f: f.update(image_size=np.array([0, 480])), ["image_size", "1-16384"]),
+    ],
+)
+def test_implausible_values_name_the_field(tmp_path, change, words):
+    f = _fields()
+    change(f)
+    path = tmp_path / "truth.npz"
+    np.savez(path, **f)
+    with pytest.raises(MotionFileError) as err:
+        read_truth(path)
+    assert str(path) in str(err.value)
+    for w in words:
+        assert w in str(err.value)
+
+
+def test_a_member_declaring_a_huge_array_is_refused_from_its_header(tmp_path):
+    """A .npy header claiming 10⁹ frames is refused before any data is read (the file is tiny)."""
+    import io
+    import zipfile
+
+    path = tmp_path / "truth.npz"
+    with zipfile.ZipFile(path, "w") as zf:
+        for name, value in _fields().items():
+            buf = io.BytesIO()
+            if name == "joints":
+                header = {"descr": "<f8", "fortran_order": False, "shape": (10**9, 21, 3)}
+                np.lib.format.write_array_header_1_0(buf, header)
+            else:
+                np.save(buf, np.asarray(value))
+            zf.writestr(f"{name}.npy", buf.getvalue())
+    assert path.stat().st_size < 20_000
+    with pytest.raises(MotionFileError, match=r"field joints has shape \(1000000000, 21, 3\)"):
+        read_truth(path)
+
+
+def test_object_arrays_are_refused_without_unpickling(tmp_path):
+    f = _fields()
+    f["joints"] = np.array([None] * 5, dtype=object)
+    path = tmp_path / "truth.npz"
+    np.savez(path, **f)
+    with pytest.raises(MotionFileError, match="field joints has dtype object"):
+        read_truth(path)
