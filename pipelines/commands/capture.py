@@ -25,7 +25,13 @@ __all__ = ["capture"]
     show_default=True,
     help="Keypoints from a video: the BlazePose model or the renderer's colour markers.",
 )
-@click.option("--tempo", type=float, default=None, help="Beats per minute (default: estimated from the movements).")
+@click.option(
+    "--tempo",
+    default=None,
+    metavar="BPM|none",
+    help="Beats per minute (default: estimated from the movements and a video's sound track); "
+    "'none' writes time as it is: 60 bpm, one beat a second.",
+)
 @click.option("--fps-override", type=float, default=None, help="Frame rate to use instead of the input's.")
 @click.option("--grid", default="1/4", show_default=True, help="Beat grid of starts and durations, e.g. 1/4 or 1/2.")
 @click.option("--no-effort", is_flag=True, help="Skip the Laban Effort estimate (the slowest step).")
@@ -42,8 +48,8 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
 
     from capture2notation.errors import PipelineError
     from capture2notation.quantise.segment import SegmentParams
+    from pipelines.capture import NO_TEMPO
     from pipelines.capture import capture as run
-    from pipelines.capture import tempo_note
 
     try:
         step = Fraction(grid)
@@ -51,7 +57,14 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         raise PipelineError(f"--grid {grid!r} must be a fraction of a beat such as 1/4") from None
     if step <= 0:
         raise PipelineError(f"--grid {grid!r} must be > 0 beats")
-    tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
+    tempo_value = tempo
+    if tempo is not None and tempo.strip().lower() != NO_TEMPO:
+        try:
+            tempo_value = Fraction(tempo.strip()).limit_denominator(1000)
+        except (ValueError, ZeroDivisionError):
+            raise PipelineError(f"--tempo {tempo!r} must be beats per minute (e.g. 72) or {NO_TEMPO!r}") from None
+    elif tempo is not None:
+        tempo_value = NO_TEMPO
     result = run(
         input_path,
         outdir,
@@ -64,10 +77,9 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         seed=seed,
         flip_test=flip_test,
     )
-    how = tempo_note(result.segmentation, result.kind) if result.segmentation.tempo_estimated else " (given)"
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
-        f"({result.kind}), tempo {result.score.tempo} bpm{how}"
+        f"({result.kind}), tempo {result.score.tempo} bpm{result.tempo_text}"
     )
     for note in result.skipped:
         click.echo(f"  not written: {note}")

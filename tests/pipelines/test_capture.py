@@ -94,23 +94,63 @@ def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
 def test_estimated_tempo_and_fps_override(sidecar, tmp_path):
     res = capture(sidecar, tmp_path / "o", progress=False, effort=False)
     assert res.segmentation.tempo_estimated and res.score.tempo == TEMPO
+    assert res.segmentation.tempo_source == "the movements"
     assert 0.5 < res.segmentation.tempo_confidence <= 1.0
     page = (tmp_path / "o" / "index.html").read_text()
-    assert f"{TEMPO} bpm (estimated, " in page and "give --tempo to fix it" in page
+    assert f"{TEMPO} bpm (estimated from the movements, " in page and "give --tempo to fix it" in page
     # Played twice as fast, the same frames are twice the tempo.
     res2 = capture(sidecar, tmp_path / "o2", fps_override=50.0, tempo=2 * TEMPO, progress=False, effort=False)
     assert score_differences(EXPECTED, res2.score.replace(tempo=TEMPO)) == []
 
 
-def test_tempo_note_of_a_video_says_how_often_it_was_right_not_the_model_confidence():
+def test_tempo_note_says_what_set_the_tempo():
     from types import SimpleNamespace
 
     from pipelines.capture import tempo_note
 
-    seg = SimpleNamespace(tempo_confidence=0.85, tempo_runner_up=72)
-    assert tempo_note(seg) == " (estimated, 85% sure; else 72 bpm; give --tempo to fix it)"
-    video = tempo_note(seg, "video")
-    assert "%" not in video and "else 72 bpm" in video and "give --tempo" in video
+    seg = SimpleNamespace(tempo_estimated=True, tempo_confidence=0.85, tempo_runner_up=72, tempo_source="the movements")
+    assert tempo_note(seg) == " (estimated from the movements, 85% sure; else 72 bpm; give --tempo to fix it)"
+    assert "; no sound track;" in tempo_note(seg, "no sound track")
+    given = SimpleNamespace(tempo_estimated=False, tempo_source="given")
+    assert tempo_note(given) == " (given)"
+    for source in ("none", "no beat"):
+        note = tempo_note(SimpleNamespace(tempo_estimated=False, tempo_source=source))
+        assert "one beat a second" in note and "given" not in note and "%" not in note
+
+
+def test_tempo_none_writes_seconds_and_says_so(sidecar, tmp_path):
+    res = capture(sidecar, tmp_path / "o", tempo="none", progress=False, effort=False)
+    assert res.score.tempo == 60 and not res.segmentation.tempo_estimated
+    assert res.segmentation.tempo_source == "none"
+    # One beat a second: every start in beats is its time in seconds (the
+    # movements of MOVES start at beats 1, 2, 3 of 72 bpm).
+    starts = sorted(float(s.start) for s in res.score.symbols)
+    assert np.allclose(starts, [b * 60 / TEMPO for b in (1, 2, 3)], atol=0.26)
+    page = (tmp_path / "o" / "index.html").read_text()
+    assert "--tempo none: one beat a second" in page
+    r = CliRunner().invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "c"), "--tempo", "none", "--no-effort"])
+    assert r.exit_code == 0, r.output
+    assert "tempo 60 bpm (not estimated, --tempo none" in r.output and "(given)" not in r.output
+    r = CliRunner().invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "d"), "--tempo", "fast"])
+    assert r.exit_code == 2 and "--tempo 'fast'" in r.output
+
+
+def test_still_motion_says_no_beat_was_found_not_given(tmp_path):
+    """Nothing moves (a truncated clip, a still dancer): 60 bpm, said to be no beat, never "(given)"."""
+    joints, angles = build_motion([], TEMPO, beats=4)
+    T = joints.shape[0]
+    path = tmp_path / "still" / "truth.npz"
+    write_truth(
+        path,
+        fps=25.0, times=np.arange(T) / 25.0, joint_names=np.asarray(JOINTS), joints=joints, angles=angles,
+        root=joints[:, 0], landmarks3d=np.full((T, 33, 3), np.nan), keypoints=np.full((T, 33, 2), np.nan),
+        visibility=np.zeros((T, 33)), K=np.eye(3), R=np.eye(3), t=np.zeros(3), image_size=np.array([64, 48]),
+        score="{}", effort="{}", view="front", style="stick", body_height=Body().height,
+    )  # fmt: skip
+    with pytest.warns(UserWarning, match="no movement found"):
+        r = CliRunner().invoke(main, ["capture", str(path), "-o", str(tmp_path / "c"), "--no-effort"])
+    assert r.exit_code == 0, r.output
+    assert "tempo 60 bpm (no beat found: one beat a second" in r.output and "(given)" not in r.output
 
 
 def test_command_line(sidecar, tmp_path):
