@@ -38,7 +38,7 @@ import numpy as np
 
 from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
-from capture2notation.errors import C2NError, PipelineError
+from capture2notation.errors import C2NError, PipelineError, QuantiseError
 from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.labels import write_labels_csv
@@ -271,7 +271,15 @@ def capture(
     t0 = time.perf_counter()
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
     given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
-    seg = segment_motion(joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence)
+    try:
+        seg = segment_motion(joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence)
+    except QuantiseError as exc:
+        if tempo is not None:
+            raise
+        # Too few movements for a beat: time as it is, one beat a second, and say so.
+        log.warning("capture: no beat found (%s): writing %d bpm, one beat a second", exc, SECONDS_TEMPO)
+        seg = segment_motion(joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title)
+        seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
     seconds["quantise"] = time.perf_counter() - t0

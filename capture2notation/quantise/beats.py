@@ -51,12 +51,18 @@ MIN_BEATS = 4
 #: Largest RMS distance of the beats from their line, in periods: more
 #: irregular than this is no steady beat.
 MAX_IRREGULARITY = 0.12
+#: Weakest onset that marks a beat, as a share of the track's strongest.
+ONSET_FRACTION = 0.3
+#: Share of the beats between the first and the last that must sound.
+MIN_COVERAGE = 0.8
 #: Quietest sound track analysed: RMS amplitude (full scale 1) below this is silence.
 SILENCE_RMS = 1e-3
 #: Relative distance within which a tempo is taken as one of the sound's levels.
 _SAME = 0.04
 #: Hop of the onset envelope, samples (23 ms at 22 050 Hz: librosa's default).
 _HOP = 512
+#: Silence added before and after the track for the onset analysis, seconds.
+_PAD_S = 0.25
 #: Window (periods either side) in which a tracked beat looks for its onset.
 _SNAP_PERIODS = 0.2
 #: Largest distance (periods) of a beat from the line to stay in the fit.
@@ -130,7 +136,9 @@ def sound_beats(track: SoundTrack) -> SoundBeats | None:
     SoundBeats or None
         None when there is no steady beat: silence (RMS below
         :data:`SILENCE_RMS`), fewer than :data:`MIN_BEATS` beats on a
-        line, or beats more irregular than :data:`MAX_IRREGULARITY`.
+        line, a line with more than a fifth of its beats silent
+        (:data:`MIN_COVERAGE`), or beats more irregular than
+        :data:`MAX_IRREGULARITY`.
 
     Raises
     ------
@@ -146,25 +154,56 @@ def sound_beats(track: SoundTrack) -> SoundBeats | None:
         raise BeatTrackerMissing(
             f"{track.source or 'sound track'}: reading its beat needs librosa: pip install 'capture2notation[audio]'"
         ) from None
-    envelope = librosa.onset.onset_strength(y=x, sr=track.rate, hop_length=_HOP)
+    # Silence either side, so that a sound at the first or last sample is an onset too.
+    pad = np.zeros(int(round(_PAD_S * track.rate)), dtype=np.float32)
+    envelope = librosa.onset.onset_strength(y=np.concatenate([pad, x, pad]), sr=track.rate, hop_length=_HOP)
     bpm, beats = librosa.beat.beat_track(onset_envelope=envelope, sr=track.rate, hop_length=_HOP, units="time")
     beats = np.asarray(beats, dtype=float)
     start = float(np.atleast_1d(bpm)[0])
     if beats.size < MIN_BEATS or not start > 0:
         return None
     period = 60.0 / start
-    times = librosa.times_like(envelope, sr=track.rate, hop_length=_HOP)
-    return _line(_onset_at_beats(beats, times, envelope, period), period)
+    times = librosa.times_like(envelope, sr=track.rate, hop_length=_HOP) - pad.size / track.rate
+    beats = beats - pad.size / track.rate
+    snapped, strength = _onset_at_beats(beats, times, envelope, period)
+    # A beat stands for an onset: the tracker's beats between onsets (its
+    # tempo misread, as on a few sparse clicks) are not evidence.
+    found = _line(snapped[strength >= ONSET_FRACTION * envelope.max()], period)
+    if found is not None:
+        return found
+    # Too few tracked beats on onsets: the onsets themselves, numbered from
+    # their median spacing.
+    peaks = _peaks(envelope, times)
+    if peaks.size < MIN_BEATS:
+        return None
+    return _line(peaks, float(np.median(np.diff(peaks))))
 
 
-def _onset_at_beats(beats: np.ndarray, times: np.ndarray, envelope: np.ndarray, period: float) -> np.ndarray:
+def _peaks(envelope: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Times (s) of the onset envelope's peaks of at least :data:`ONSET_FRACTION` of its largest."""
+    from scipy.signal import find_peaks
+
+    hop_s = float(times[1] - times[0]) if times.size > 1 else 1.0
+    idx, _ = find_peaks(envelope, height=ONSET_FRACTION * float(envelope.max()), distance=max(1, int(0.1 / hop_s)))
+    return times[idx].astype(float)
+
+
+def _onset_at_beats(beats: np.ndarray, times: np.ndarray, envelope: np.ndarray, period: float):
     """Each tracked beat moved to the strongest onset within ±:data:`_SNAP_PERIODS` of a period.
 
     The dynamic programme places beats on its own (coarse) tempo's grid, up
     to a few hops off the onsets they stand for; the onsets are the sound's
     own timing (to a fraction of a hop, by a parabola through the peak).
+
+    Returns
+    -------
+    (B,) ndarray
+        The moved beats, seconds.
+    (B,) ndarray
+        The onset strength there (0 where none is near).
     """
     out = beats.copy()
+    strength = np.zeros(beats.size)
     hop_s = float(times[1] - times[0]) if times.size > 1 else 0.0
     for i, b in enumerate(beats):
         near = np.flatnonzero(np.abs(times - b) <= _SNAP_PERIODS * period)
@@ -177,7 +216,8 @@ def _onset_at_beats(beats: np.ndarray, times: np.ndarray, envelope: np.ndarray, 
             den = a - 2.0 * c + e
             shift = 0.5 * (a - e) / den if den < 0 else 0.0
         out[i] = float(times[j]) + shift * hop_s
-    return out
+        strength[i] = float(envelope[j])
+    return out, strength
 
 
 def _line(beats: np.ndarray, period: float) -> SoundBeats | None:
@@ -202,6 +242,9 @@ def _line(beats: np.ndarray, period: float) -> SoundBeats | None:
         keep = np.abs(beats - (k * period + intercept)) <= _OUTLIER_PERIODS * period
     kk, resid = k[keep], (beats - (k * period + intercept))[keep]
     if kk.size < MIN_BEATS or np.ptp(kk) < MIN_BEATS - 1:
+        return None
+    # A steady beat sounds on (nearly) every beat between its first and last.
+    if np.unique(kk).size < MIN_COVERAGE * (np.ptp(kk) + 1):
         return None
     irregular = float(np.sqrt(np.mean(resid**2)) / period)
     if irregular > MAX_IRREGULARITY:

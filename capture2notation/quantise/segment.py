@@ -359,21 +359,17 @@ def segment_motion(
             # Clean key times are within half a frame of their grid time;
             # measured ones (fitted logistic, noisy) within a frame or two.
             tol = (0.3 if clean else 2.0) / fps
-            try:
-                detail = estimate_tempo_detail(
-                    times,
-                    params.grid,
-                    tolerance_s=tol,
-                    durations=gestures or None,
-                    groups=groups,
-                    max_offset_s=0.0 if clean else 3.0 / fps,
-                    evidence=tempo_evidence,
-                )
-                tempo = detail.tempo
-            except QuantiseError as exc:
-                # Too few key times for a beat: write time as it is, one beat a second.
-                warnings.warn(f"no beat found ({exc}): writing 60 bpm, one beat a second", stacklevel=2)
-                tempo, estimated = Fraction(60), False
+            detail = estimate_tempo_detail(
+                times,
+                params.grid,
+                tolerance_s=tol,
+                durations=gestures or None,
+                groups=groups,
+                max_offset_s=0.0 if clean else 3.0 / fps,
+                evidence=tempo_evidence,
+                measured=not clean,
+            )
+            tempo = detail.tempo
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
     if tempo <= 0:
         raise QuantiseError(f"tempo must be > 0 beats per minute, got {tempo}")
