@@ -19,6 +19,11 @@ written atomically into OUTDIR:
 ``index.html``      the staff beside the overlay video
 ==================  ==========================================================
 
+The tempo is given (``tempo=``), ``"none"`` (60 bpm: one beat a second),
+or estimated from the movements and, for a video with a sound track, its
+beat (:mod:`capture2notation.quantise.beats`, the optional ``audio`` extra);
+the page and the command line say which, and how sure.
+
 For a rendered video with its ``truth.npz`` beside it, the fit uses the
 sidecar's camera (known intrinsics and pose); otherwise the fitting stage's
 default camera refined from the data.

@@ -221,9 +221,9 @@ def estimate_tempo_detail(
 
     Accepted ambiguity: a phrase whose every movement lasts two beats is the
     same motion as one-beat movements at half the tempo; the estimate
-    prefers one movement a beat unless the tempo prior (half of a tempo
-    below about 50 bpm is unlikely) says otherwise, and its confidence
-    says how sure it is.
+    prefers one movement a beat, the log-normal tempo prior weighing in,
+    and its confidence says how sure it is (too sure on such phrases:
+    ``docs/benchmarks/tempo.md``).
 
     Parameters
     ----------

@@ -260,6 +260,7 @@ def _clicked_render(tmp_path, tempo=90):
     return tmp_path / "r" / "video.mp4"
 
 
+@pytest.mark.slow
 def test_tempo_from_a_click_track(tmp_path):
     """A render with a click track: the sound's beat sets the tempo, and the page says so."""
     pytest.importorskip("librosa")

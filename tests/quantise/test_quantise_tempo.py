@@ -54,11 +54,11 @@ def test_tempo_from_grid_times_with_one_beat_movements():
     seed 102247); at most 2 % of the sweep may be, and only at half."""
     results = []
     for tempo in range(40, 121, 4):
-        for seed in range(30):
+        for seed in range(18):
             t, durations = _phrase(tempo, seed)
             if np.mean(np.isclose(durations, 60.0 / tempo)) >= 0.75:
                 results.append(estimate_tempo(t, tolerance_s=0.012, durations=durations) / tempo)
-    assert len(results) > 100
+    assert len(results) > 50
     assert np.mean([r == 1 for r in results]) >= 0.98
     assert all(r in (1, F(1, 2)) for r in results)
 
