@@ -7,6 +7,7 @@ expected, so a user can fix the input without reading the code.
 from __future__ import annotations
 
 __all__ = [
+    "AudioError",
     "BodyModelError",
     "C2NError",
     "CalibrationError",
@@ -70,6 +71,10 @@ class SyntheticError(C2NError):
 
 class VideoError(C2NError):
     """Unreadable, empty or corrupt video / image folder."""
+
+
+class AudioError(VideoError):
+    """A sound track that cannot be decoded, written or muxed (a video's audio, or a music file)."""
 
 
 class ModelError(C2NError):

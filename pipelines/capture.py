@@ -19,6 +19,11 @@ written atomically into OUTDIR:
 ``index.html``      the staff beside the overlay video
 ==================  ==========================================================
 
+The tempo is given (``tempo=``), ``"none"`` (60 bpm: one beat a second),
+or estimated from the movements and, for a video with a sound track, its
+beat (:mod:`capture2notation.quantise.beats`, the optional ``audio`` extra);
+the page and the command line say which, and how sure.
+
 For a rendered video with its ``truth.npz`` beside it, the fit uses the
 sidecar's camera (known intrinsics and pose); otherwise the fitting stage's
 default camera refined from the data.
@@ -35,13 +40,14 @@ import tempfile
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 
 from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
-from capture2notation.errors import C2NError, PipelineError
+from capture2notation.errors import C2NError, PipelineError, QuantiseError
 from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.labels import write_labels_csv
@@ -51,7 +57,16 @@ from capture2notation.quantise.segment import (
     segment_motion,
 )
 
-__all__ = ["MOTION_SUFFIXES", "VIDEO_SUFFIXES", "CaptureResult", "capture", "input_kind", "load_motion", "tempo_note"]
+__all__ = [
+    "MOTION_SUFFIXES",
+    "NO_TEMPO",
+    "VIDEO_SUFFIXES",
+    "CaptureResult",
+    "capture",
+    "input_kind",
+    "load_motion",
+    "tempo_note",
+]
 
 log = logging.getLogger(__name__)
 
@@ -81,6 +96,8 @@ class CaptureResult:
         Wall-clock time of each stage.
     skipped : tuple of str
         Outputs not written, with the reason.
+    tempo_text : str
+        How the tempo was set, after "tempo N bpm" (:func:`tempo_note`).
     """
 
     outdir: Path
@@ -92,6 +109,7 @@ class CaptureResult:
     files: dict = field(default_factory=dict)
     seconds: dict = field(default_factory=dict)
     skipped: tuple = ()
+    tempo_text: str = ""
 
     @property
     def n_frames(self) -> int:
@@ -175,10 +193,19 @@ def load_motion(
     return motion, None, seconds
 
 
+#: ``tempo=`` (``--tempo``) value that writes time as it is: one beat a second.
+NO_TEMPO = "none"
+#: The tempo written for :data:`NO_TEMPO` and when no beat is found, bpm: one beat a second.
+SECONDS_TEMPO = 60
+
+
 def _check_options(backend: str, tempo, fps_override) -> None:
     if backend not in ("blazepose", "markers"):
         raise PipelineError(f"--backend {backend!r} is not one of blazepose, markers")
-    if tempo is not None and not (np.isfinite(float(tempo)) and 0 < float(tempo) <= 400):
+    if isinstance(tempo, str):
+        if tempo != NO_TEMPO:
+            raise PipelineError(f"--tempo {tempo!r} must be beats per minute in (0, 400] or {NO_TEMPO!r}")
+    elif tempo is not None and not (np.isfinite(float(tempo)) and 0 < float(tempo) <= 400):
         raise PipelineError(f"--tempo {tempo!r} must be beats per minute in (0, 400]")
     if fps_override is not None and not (np.isfinite(float(fps_override)) and 0 < float(fps_override) <= 1000):
         raise PipelineError(f"--fps-override {fps_override!r} must be a frame rate in (0, 1000]")
@@ -209,8 +236,10 @@ def capture(
         Created if missing; see the module docstring for its files.
     backend : {"blazepose", "markers"}
         Keypoint backend for video input.
-    tempo : float, optional
-        Beats per minute; estimated from the key frames when omitted.
+    tempo : float or "none", optional
+        Beats per minute; estimated when omitted (from the movements, and
+        from the sound track's beats when a video has one); ``"none"``
+        writes time as it is: 60 bpm, one beat a second.
     fps_override : float, optional
         Frame rate to use instead of the file's.
     progress : bool
@@ -242,12 +271,28 @@ def capture(
     if not np.isfinite(joints).any():
         raise PipelineError(f"{input_path}: no frame could be measured (no person found?)")
 
+    evidence, sound = None, ""
+    if kind == "video" and tempo is None:
+        t0 = time.perf_counter()
+        evidence, sound = _sound_evidence(input_path, fps)
+        seconds["sound"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
-    seg = segment_motion(joints, fps, tempo=tempo, meter=meter, params=params, title=title)
+    given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
+    try:
+        seg = segment_motion(joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence)
+    except QuantiseError as exc:
+        if tempo is not None:
+            raise
+        # Too few movements for a beat: time as it is, one beat a second, and say so.
+        log.warning("capture: no beat found (%s): writing %d bpm, one beat a second", exc, SECONDS_TEMPO)
+        seg = segment_motion(joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title)
+        seg = replace(seg, tempo_source="no beat")
+    if tempo == NO_TEMPO:
+        seg = replace(seg, tempo_source=NO_TEMPO)
     seconds["quantise"] = time.perf_counter() - t0
-    if seg.tempo_estimated:
-        log.info("capture: estimated tempo %s bpm%s", seg.tempo, tempo_note(seg, kind))
+    how = tempo_note(seg, sound)
+    log.info("capture: tempo %s bpm%s", seg.tempo, how)
     with _staging(outdir) as stage:
         files, skipped = _write_outputs(stage, seg, motion, track, input_path, kind, overlay)
         if effort:
@@ -259,7 +304,7 @@ def capture(
                 skipped.append(f"effort.json: {exc}")
                 log.warning("capture: effort not estimated: %s", exc)
             seconds["effort"] = time.perf_counter() - t0
-        staged = CaptureResult(outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped))
+        staged = CaptureResult(outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped), how)
         files["index.html"] = write_text(stage / "index.html", index_html(staged))
         files = {name: outdir / Path(p).relative_to(stage) for name, p in files.items()}
     return replace(staged, files=files)
@@ -359,31 +404,64 @@ def _interval(d: dict) -> str:
     return f"{d['median']:.2f} [{lo:.2f}, {hi:.2f}]"
 
 
-#: Share of video captures whose estimated tempo was within 15 % of the
-#: written one (16 of 51: the held-out phrases and development clips, three
-#: views, ``benchmarks/bench_wholepath.py``); the model's own confidence
-#: averaged 71 % on them, so it is not shown for videos.
-VIDEO_TEMPO_RIGHT = "a third"
+def _sound_evidence(path, fps: float):
+    """The beat of a video's sound track as tempo evidence, and what became of it (for the page).
 
-
-def tempo_note(seg, kind: str | None = None) -> str:
-    """Text after an estimated tempo, e.g. ``" (estimated, 80% sure; else 36 bpm; give --tempo to fix it)"``.
-
-    A tempo estimated from movement alone may be half or double the one
-    the dancers counted; the page and the command line say so.  For a
-    video (`kind` ``"video"``) the model's confidence is not calibrated —
-    fitted movements come out split and shorter than danced — so the note
-    gives how often it has been right instead.
+    Returns
+    -------
+    SoundBeats or None
+        None when there is no sound, no steady beat, or no beat tracker.
+    str
+        "" when the beat is used, else why not.
     """
-    other = f"; else {seg.tempo_runner_up} bpm" if seg.tempo_runner_up is not None else ""
-    if kind == "video":
-        return (
-            f" (estimated from the movements{other}; on video it has been right about {VIDEO_TEMPO_RIGHT} "
-            "of the time: give --tempo)"
-        )
+    from dataclasses import replace as _replace
+
+    from capture2notation.io.audio import read_audio
+    from capture2notation.io.video import probe
+    from capture2notation.quantise.beats import BeatTrackerMissing, sound_beats
+
+    try:
+        track = read_audio(path)
+    except C2NError as exc:
+        log.warning("capture: sound track not read: %s", exc)
+        return None, "its sound track could not be read"
+    if track is None:
+        return None, "no sound track"
+    try:
+        beats = sound_beats(track)
+    except BeatTrackerMissing as exc:
+        log.warning("capture: %s; the tempo comes from the movements alone", exc)
+        return None, "the sound track was not read: pip install 'capture2notation[audio]' for its beat"
+    if beats is None:
+        return None, "no steady beat in the sound track"
+    # Frames re-timed by --fps-override play the sound as fast as the pictures.
+    rate = probe(path).fps
+    if abs(fps / rate - 1.0) > 1e-6:
+        beats = _replace(beats, tempo=beats.tempo * fps / rate, beat_times=beats.beat_times * rate / fps)
+    return beats, ""
+
+
+def tempo_note(seg, sound: str = "") -> str:
+    """Text after "tempo N bpm", e.g. ``" (estimated from the movements, 80% sure; else 36 bpm; give --tempo to fix it)"``.
+
+    Says what set the tempo (``seg.tempo_source``): given, ``--tempo none``
+    (one beat a second), no beat found (one beat a second), or estimated —
+    from what, how sure (the calibrated confidence,
+    :func:`capture2notation.quantise.tempo.estimate_tempo_detail`) and the
+    other reading.  `sound` says why a video's sound track was not used.
+    """
+    source = getattr(seg, "tempo_source", "given")
+    if source == NO_TEMPO:
+        return " (not estimated, --tempo none: one beat a second, so beats are seconds)"
+    if source == "no beat":
+        return " (no beat found: one beat a second, so beats are seconds; give --tempo)"
+    if not seg.tempo_estimated:
+        return " (given)"
     conf = seg.tempo_confidence
     sure = f", {conf:.0%} sure" if np.isfinite(conf) else ""
-    return f" (estimated{sure}{other}; give --tempo to fix it)"
+    other = f"; else {seg.tempo_runner_up} bpm" if seg.tempo_runner_up is not None else ""
+    why = f"; {sound}" if sound else ""
+    return f" (estimated from {source}{sure}{other}{why}; give --tempo to fix it)"
 
 
 def _effort_html(files: dict) -> str:
@@ -434,9 +512,7 @@ def index_html(result: CaptureResult) -> str:
     links = " · ".join(
         f'<a href="{html.escape(n)}">{html.escape(n)}</a>' for n in sorted(result.files) if n != "index.html"
     )
-    tempo = f"{score.tempo} bpm" + (
-        tempo_note(result.segmentation, result.kind) if result.segmentation.tempo_estimated else ""
-    )
+    tempo = f"{score.tempo} bpm{result.tempo_text}"
     skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
     effort = _effort_html(result.files)

@@ -141,8 +141,12 @@ class Segmentation:
     tempo_runner_up : Fraction or None
         When estimated: the best other reading (usually half or double).
     tempo_confidence : float
-        When estimated: probability that the tempo is within 15 % of
+        When estimated: probability that the tempo is within 4 % of
         `tempo`; NaN when the tempo was given.
+    tempo_source : str
+        What set the tempo: ``"given"``, ``"no beat"`` (nothing to estimate
+        it from: 60 bpm, one beat a second) or, when estimated, what it was
+        estimated from (``"the movements"``, ``"the sound track and the movements"``).
     """
 
     score: Score
@@ -153,6 +157,7 @@ class Segmentation:
     labels: FrameLabels = field(repr=False)
     tempo_runner_up: Fraction | None = None
     tempo_confidence: float = float("nan")
+    tempo_source: str = "given"
 
 
 # Gesture channels: part, segment label columns (upper, lower) or single.
@@ -283,6 +288,7 @@ def segment_motion(
     params: SegmentParams | None = None,
     floor: float = 0.0,
     title: str = "",
+    tempo_evidence=None,
 ) -> Segmentation:
     """Segment a motion into notation symbols.
 
@@ -300,6 +306,9 @@ def segment_motion(
     floor : float
         Floor height, metres.
     title : str
+    tempo_evidence : TempoEvidence, optional
+        Evidence on the tempo besides the movements (a sound track's beats,
+        :mod:`capture2notation.quantise.beats`), when it is estimated.
 
     Returns
     -------
@@ -324,7 +333,7 @@ def segment_motion(
         # raised from the capture's own flat foot, not from the model's.
         flat = flat_foot_pitch(smoothed, contact) if measured else None
         labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat))
-    estimated = tempo is None
+    estimated = tempo_was_none = tempo is None
     moves, detail = None, None
     if estimated:
         moves = _gesture_movements(labels, joints, fps, params, measured=measured) + support_movements(
@@ -341,7 +350,7 @@ def segment_motion(
         # Fitted starts and arrivals carry different timing biases (a heavy,
         # late-peaking Effort is fitted with a late arrival): groups 0 and 1.
         groups = np.tile([0, 1], len(timed))
-        if len(moves) == 0:
+        if len(moves) == 0 and tempo_evidence is None:
             # Nothing moves: the (empty) score needs some tempo; say so, invent nothing else.
             warnings.warn("no movement found: the tempo cannot be estimated, writing 60 bpm", stacklevel=2)
             tempo, estimated = Fraction(60), False
@@ -357,6 +366,8 @@ def segment_motion(
                 durations=gestures or None,
                 groups=groups,
                 max_offset_s=0.0 if clean else 3.0 / fps,
+                evidence=tempo_evidence,
+                measured=not clean,
             )
             tempo = detail.tempo
     tempo = Fraction(tempo).limit_denominator(1000) if not isinstance(tempo, Fraction) else tempo
@@ -383,7 +394,8 @@ def segment_motion(
     key_frames = np.unique(np.r_[0, [min(m.end_frame, T - 1) for m in moves]].astype(int))
     score = Score(symbols=tuple(symbols), title=title, tempo=tempo, meter=meter)
     if detail is None:
-        return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels)
+        source = "no beat" if tempo_was_none else "given"
+        return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels, tempo_source=source)
     return Segmentation(
         score,
         tuple(moves),
@@ -393,6 +405,7 @@ def segment_motion(
         labels,
         tempo_runner_up=detail.runner_up,
         tempo_confidence=detail.confidence,
+        tempo_source=detail.source,
     )
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from .options import FPS, TEMPO, check_outdir
+from .options import FPS, TEMPO_OR_NONE, check_outdir
 
 __all__ = ["capture"]
 
@@ -27,7 +27,14 @@ __all__ = ["capture"]
     show_default=True,
     help="Keypoints from a video: the BlazePose model or the renderer's colour markers.",
 )
-@click.option("--tempo", type=TEMPO, default=None, help="Beats per minute (default: estimated from the movements).")
+@click.option(
+    "--tempo",
+    type=TEMPO_OR_NONE,
+    default=None,
+    metavar="BPM|none",
+    help="Beats per minute (default: estimated from the movements and a video's sound track); "
+    "'none' writes time as it is: 60 bpm, one beat a second.",
+)
 @click.option("--fps-override", type=FPS, default=None, help="Frame rate to use instead of the input's.")
 @click.option("--grid", default="1/4", show_default=True, help="Beat grid of starts and durations, e.g. 1/4 or 1/2.")
 @click.option("--no-effort", is_flag=True, help="Skip the Laban Effort estimate (the slowest step).")
@@ -44,8 +51,8 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
 
     from capture2notation.errors import PipelineError
     from capture2notation.quantise.segment import SegmentParams
+    from pipelines.capture import NO_TEMPO
     from pipelines.capture import capture as run
-    from pipelines.capture import tempo_note
 
     try:
         step = Fraction(grid)
@@ -54,7 +61,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
     if not 0 < step <= 4:
         raise PipelineError(f"--grid {grid!r} must be a fraction of a beat in (0, 4]")
     check_outdir(outdir)
-    tempo_value = None if tempo is None else Fraction(tempo).limit_denominator(1000)
+    tempo_value = tempo if tempo is None or tempo == NO_TEMPO else Fraction(tempo).limit_denominator(1000)
     result = run(
         input_path,
         outdir,
@@ -67,10 +74,9 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         seed=seed,
         flip_test=flip_test,
     )
-    how = tempo_note(result.segmentation, result.kind) if result.segmentation.tempo_estimated else " (given)"
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
-        f"({result.kind}), tempo {result.score.tempo} bpm{how}"
+        f"({result.kind}), tempo {result.score.tempo} bpm{result.tempo_text}"
     )
     for note in result.skipped:
         click.echo(f"  not written: {note}")

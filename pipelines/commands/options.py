@@ -16,7 +16,16 @@ import click
 
 from capture2notation.errors import PipelineError
 
-__all__ = ["FPS", "TEMPO", "Number", "check_outdir", "check_output_file", "score_format_or_fail"]
+__all__ = [
+    "FPS",
+    "TEMPO",
+    "TEMPO_OR_NONE",
+    "Number",
+    "TempoOrNone",
+    "check_outdir",
+    "check_output_file",
+    "score_format_or_fail",
+]
 
 
 class Number(click.ParamType):
@@ -58,6 +67,21 @@ class Number(click.ParamType):
 #: Beats per minute a dance can be counted at: below 10 there is no beat to
 #: count, above 400 is faster than any dance music (speedcore runs near 300).
 TEMPO = Number(10, 400, "beats per minute")
+
+
+class TempoOrNone(click.ParamType):
+    """A tempo in :data:`TEMPO`'s range, or ``none`` (time written as it is: 60 bpm)."""
+
+    name = "tempo"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and value.strip().lower() == "none":
+            return "none"
+        return TEMPO.convert(value, param, ctx)
+
+
+#: ``--tempo`` of a capture: beats per minute, or ``none``.
+TEMPO_OR_NONE = TempoOrNone()
 #: Frames per second of a video, a motion file or a rendered performance
 #: (the readers' :data:`~capture2notation.io.limits.MAX_FPS`).
 FPS = Number(0, 1000, "frames per second", open_low=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import click
 
@@ -55,7 +56,14 @@ def _fps(value: float) -> float:
 @click.option("--style", default="mannequin", show_default=True, help="Drawing: mannequin, stick or markers.")
 @click.option("--emotion", default=None, help="Perform with an emotion preset: happy, sad, angry or afraid.")
 @click.option("--png", is_flag=True, help="Write the frames as OUTDIR/frames/frame_NNNNNN.png instead of video.mp4.")
-def render(score, outdir, fps, size, view, style, emotion, png):
+@click.option(
+    "--audio",
+    default=None,
+    metavar="click|FILE",
+    help="Give video.mp4 a sound track: 'click' (a click on every beat at the score's tempo, "
+    "the first of each measure accented) or a music file's sound.",
+)
+def render(score, outdir, fps, size, view, style, emotion, png, audio):
     """Perform the notation in SCORE (.lab, .json, 1974 coded input) with the
     virtual dancer and render it with its ground truth."""
     from capture2notation.notation import EMOTIONS
@@ -69,11 +77,25 @@ def render(score, outdir, fps, size, view, style, emotion, png):
     check_choice(view, "--view", list(VIEWS))
     check_choice(style, "--style", list(STYLES))
     check_choice(emotion, "--emotion", list(EMOTIONS))
+    if audio is not None and png:
+        raise PipelineError("--audio needs video.mp4: a folder of PNG frames (--png) has no sound track")
+    if audio is not None and audio != "click" and not Path(audio).is_file():
+        raise PipelineError(f"--audio {audio!r}: no such file; expected 'click' or a music file")
     parsed = read(score)
     video = "frames" if png else "video.mp4"
     out = render_score(
-        parsed, outdir, fps=fps, size=wh, view=view, style=style, emotion=emotion, progress=True, video_name=video
+        parsed,
+        outdir,
+        fps=fps,
+        size=wh,
+        view=view,
+        style=style,
+        emotion=emotion,
+        progress=True,
+        video_name=video,
+        audio=audio,
     )
+    sound = "" if audio is None else (", with a click track" if audio == "click" else f", with the sound of {audio}")
     click.echo(
-        f"{out}: {video}, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps)"
+        f"{out}: {video}, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps{sound})"
     )

@@ -149,6 +149,7 @@ def render_score(
     progress: bool = True,
     body: Body | None = None,
     video_name: str = "video.mp4",
+    audio: str | None = None,
 ) -> Path:
     """Perform a score with the virtual dancer and render it.
 
@@ -173,6 +174,10 @@ def render_score(
         Default ``Body()``.
     video_name : str
         ``*.mp4`` for a video, a name without suffix for a folder of PNG frames.
+    audio : str, optional
+        Sound for the mp4: ``"click"`` (a click track at the score's tempo,
+        the first beat of each measure accented) or a music file's path
+        (:func:`synthetic.render.sound.add_sound`).
 
     Returns
     -------
@@ -202,5 +207,9 @@ def render_score(
         progress=progress,
         video_name=video_name,
     )
+    if audio is not None:
+        from .sound import add_sound
+
+        add_sound(outdir / video_name, audio, score.tempo, score.meter, motion.angles.shape[0] / float(motion.fps))
     write(score, outdir / "score.lab")
     return outdir

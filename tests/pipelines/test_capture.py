@@ -94,23 +94,63 @@ def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
 def test_estimated_tempo_and_fps_override(sidecar, tmp_path):
     res = capture(sidecar, tmp_path / "o", progress=False, effort=False)
     assert res.segmentation.tempo_estimated and res.score.tempo == TEMPO
+    assert res.segmentation.tempo_source == "the movements"
     assert 0.5 < res.segmentation.tempo_confidence <= 1.0
     page = (tmp_path / "o" / "index.html").read_text()
-    assert f"{TEMPO} bpm (estimated, " in page and "give --tempo to fix it" in page
+    assert f"{TEMPO} bpm (estimated from the movements, " in page and "give --tempo to fix it" in page
     # Played twice as fast, the same frames are twice the tempo.
     res2 = capture(sidecar, tmp_path / "o2", fps_override=50.0, tempo=2 * TEMPO, progress=False, effort=False)
     assert score_differences(EXPECTED, res2.score.replace(tempo=TEMPO)) == []
 
 
-def test_tempo_note_of_a_video_says_how_often_it_was_right_not_the_model_confidence():
+def test_tempo_note_says_what_set_the_tempo():
     from types import SimpleNamespace
 
     from pipelines.capture import tempo_note
 
-    seg = SimpleNamespace(tempo_confidence=0.85, tempo_runner_up=72)
-    assert tempo_note(seg) == " (estimated, 85% sure; else 72 bpm; give --tempo to fix it)"
-    video = tempo_note(seg, "video")
-    assert "%" not in video and "else 72 bpm" in video and "give --tempo" in video
+    seg = SimpleNamespace(tempo_estimated=True, tempo_confidence=0.85, tempo_runner_up=72, tempo_source="the movements")
+    assert tempo_note(seg) == " (estimated from the movements, 85% sure; else 72 bpm; give --tempo to fix it)"
+    assert "; no sound track;" in tempo_note(seg, "no sound track")
+    given = SimpleNamespace(tempo_estimated=False, tempo_source="given")
+    assert tempo_note(given) == " (given)"
+    for source in ("none", "no beat"):
+        note = tempo_note(SimpleNamespace(tempo_estimated=False, tempo_source=source))
+        assert "one beat a second" in note and "given" not in note and "%" not in note
+
+
+def test_tempo_none_writes_seconds_and_says_so(sidecar, tmp_path):
+    res = capture(sidecar, tmp_path / "o", tempo="none", progress=False, effort=False)
+    assert res.score.tempo == 60 and not res.segmentation.tempo_estimated
+    assert res.segmentation.tempo_source == "none"
+    # One beat a second: every start in beats is its time in seconds (the
+    # movements of MOVES start at beats 1, 2, 3 of 72 bpm).
+    starts = sorted(float(s.start) for s in res.score.symbols)
+    assert np.allclose(starts, [b * 60 / TEMPO for b in (1, 2, 3)], atol=0.26)
+    page = (tmp_path / "o" / "index.html").read_text()
+    assert "--tempo none: one beat a second" in page
+    r = CliRunner().invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "c"), "--tempo", "none", "--no-effort"])
+    assert r.exit_code == 0, r.output
+    assert "tempo 60 bpm (not estimated, --tempo none" in r.output and "(given)" not in r.output
+    r = CliRunner().invoke(main, ["capture", str(sidecar), "-o", str(tmp_path / "d"), "--tempo", "fast"])
+    assert r.exit_code == 2 and "--tempo 'fast'" in r.output
+
+
+def test_still_motion_says_no_beat_was_found_not_given(tmp_path):
+    """Nothing moves (a truncated clip, a still dancer): 60 bpm, said to be no beat, never "(given)"."""
+    joints, angles = build_motion([], TEMPO, beats=4)
+    T = joints.shape[0]
+    path = tmp_path / "still" / "truth.npz"
+    write_truth(
+        path,
+        fps=25.0, times=np.arange(T) / 25.0, joint_names=np.asarray(JOINTS), joints=joints, angles=angles,
+        root=joints[:, 0], landmarks3d=np.full((T, 33, 3), np.nan), keypoints=np.full((T, 33, 2), np.nan),
+        visibility=np.zeros((T, 33)), K=np.eye(3), R=np.eye(3), t=np.zeros(3), image_size=np.array([64, 48]),
+        score="{}", effort="{}", view="front", style="stick", body_height=Body().height,
+    )  # fmt: skip
+    with pytest.warns(UserWarning, match="no movement found"):
+        r = CliRunner().invoke(main, ["capture", str(path), "-o", str(tmp_path / "c"), "--no-effort"])
+    assert r.exit_code == 0, r.output
+    assert "tempo 60 bpm (no beat found: one beat a second" in r.output and "(given)" not in r.output
 
 
 def test_command_line(sidecar, tmp_path):
@@ -203,3 +243,73 @@ def test_a_kinect_recording_of_the_port_de_bras_gives_its_score(tmp_path):
     # Measured 1.0 (direction + level per part per beat); the rounded arms'
     # bend and the last beat's timing differ slightly: Kinect has no hand tip.
     assert a.symbol_agreement >= 0.95, score_differences(score, res.score)
+
+
+def _clicked_render(tmp_path, tempo=90):
+    from capture2notation.notation.formats import loads
+    from synthetic import render
+
+    score = loads(
+        f"tempo: {tempo}\n0 1 right_arm right middle\n1 1 right_arm place low\n2 1 left_arm left middle\n"
+        "3 1 left_arm place low\n4 1 right_arm forward high\n5 1 right_arm place low\n",
+        "lab",
+    )
+    render.render_score(
+        score, tmp_path / "r", fps=25, size=(320, 240), view="front", style="markers", progress=False, audio="click"
+    )
+    return tmp_path / "r" / "video.mp4"
+
+
+@pytest.mark.slow
+def test_tempo_from_a_click_track(tmp_path):
+    """A render with a click track: the sound's beat sets the tempo, and the page says so."""
+    pytest.importorskip("librosa")
+    video = _clicked_render(tmp_path, tempo=97)
+    res = capture(video, tmp_path / "c", backend="markers", progress=False, effort=False, overlay=False)
+    assert res.score.tempo == 97 and res.segmentation.tempo_source == "the sound track and the movements"
+    assert "estimated from the sound track and the movements" in (tmp_path / "c" / "index.html").read_text()
+    # --tempo none ignores the sound: one beat a second.
+    none = capture(video, tmp_path / "n", backend="markers", tempo="none", progress=False, effort=False, overlay=False)
+    assert none.score.tempo == 60 and none.segmentation.tempo_source == "none"
+
+
+def test_without_librosa_the_capture_says_how_to_read_the_sound(tmp_path, monkeypatch):
+    video = _clicked_render(tmp_path)
+    monkeypatch.setitem(sys.modules, "librosa", None)
+    res = capture(video, tmp_path / "c", backend="markers", progress=False, effort=False, overlay=False)
+    assert res.segmentation.tempo_source == "the movements"
+    assert "pip install 'capture2notation[audio]'" in res.tempo_text
+
+
+def test_render_command_line_audio_options(tmp_path):
+    score = tmp_path / "p.lab"
+    score.write_text("tempo: 120\n0 1 right_arm right middle\n")
+    runner = CliRunner()
+    r = runner.invoke(main, ["render", str(score), "-o", str(tmp_path / "a"), "--size", "64x48", "--audio", "click"])
+    assert r.exit_code == 0, r.output
+    assert "with a click track" in r.output
+    from capture2notation.io.audio import read_audio
+
+    assert read_audio(tmp_path / "a" / "video.mp4") is not None
+    r = runner.invoke(main, ["render", str(score), "-o", str(tmp_path / "b"), "--png", "--audio", "click"])
+    assert r.exit_code == 2 and "--png" in r.output
+    r = runner.invoke(main, ["render", str(score), "-o", str(tmp_path / "c"), "--audio", str(tmp_path / "no.mp3")])
+    assert r.exit_code == 2 and "no such file" in r.output
+
+
+def test_one_movement_is_no_beat_and_says_so(tmp_path):
+    """One movement from the first frame: a single key time, no beat to find."""
+    joints, angles = build_motion([(0, 1, "right_shoulder", arm_angles("right", "middle"))], TEMPO, beats=3)
+    T = joints.shape[0]
+    path = tmp_path / "one" / "truth.npz"
+    write_truth(
+        path,
+        fps=25.0, times=np.arange(T) / 25.0, joint_names=np.asarray(JOINTS), joints=joints, angles=angles,
+        root=joints[:, 0], landmarks3d=np.full((T, 33, 3), np.nan), keypoints=np.full((T, 33, 2), np.nan),
+        visibility=np.zeros((T, 33)), K=np.eye(3), R=np.eye(3), t=np.zeros(3), image_size=np.array([64, 48]),
+        score="{}", effort="{}", view="front", style="stick", body_height=Body().height,
+    )  # fmt: skip
+    res = capture(path, tmp_path / "c", progress=False, effort=False)
+    assert res.score.tempo == 60 and res.segmentation.tempo_source == "no beat"
+    assert res.tempo_text.startswith(" (no beat found: one beat a second")
+    assert [s.part for s in res.score.symbols] == ["right_arm"]
