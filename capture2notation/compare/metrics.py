@@ -345,7 +345,11 @@ def compare_movements(
             cbend = int(bend_degree(bend_angle(j[joint_index(a)], j[joint_index(m)], j[joint_index(b)])))
         want = (sym.direction, sym.level) if against == "notation" else (rdir, rlev)
         agree = bool(cdir) and (cdir, clev) == want
-        if not agree:
+        if against == "reference" and not rdir:
+            # The reference's own pose is not measured at its key frame (a limb
+            # the sensor lost): there is nothing to agree with.
+            verdict = "n/a"
+        elif not agree:
             verdict = "pose"
         elif abs(offset) <= timing_tolerance:
             verdict = "match"

@@ -77,7 +77,10 @@ class TempoOrNone(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, str) and value.strip().lower() == "none":
             return "none"
-        return TEMPO.convert(value, param, ctx)
+        try:
+            return TEMPO.convert(value, param, ctx)
+        except click.BadParameter as exc:
+            self.fail(f"{exc.message}; or 'none' to write time as it is", param, ctx)
 
 
 #: ``--tempo`` of a capture: beats per minute, or ``none``.

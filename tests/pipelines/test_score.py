@@ -171,8 +171,8 @@ def test_a_performance_against_itself_scores_exactly_100(performances, fixture_p
 
 
 def test_different_random_scores_score_low_and_are_not_the_same_piece(performances, tmp_path):
-    """Independent random phrases agree only by chance (about 10 % for random arm directions),
-    as scores (tempo alignment) and as motion files (warping)."""
+    """Independent random phrases agree only by chance (10-25 % for random arm directions,
+    given each side's symbol frequencies), as scores (tempo alignment) and as motion files (warping)."""
     from pipelines.score import summary_dict
 
     ref_score, ref_bvh = load_side(performances["score"]), load_side(performances["bvh"])
@@ -182,7 +182,9 @@ def test_different_random_scores_score_low_and_are_not_the_same_piece(performanc
         cand_bvh = load_side(_bvh(other, tmp_path / f"b{seed}.bvh"))
         for cand, ref in ((cand_score, ref_score), (cand_bvh, ref_bvh)):
             summ = summary_dict(cand, ref, compare_sides(cand, ref))
-            assert summ["symbol_agreement"] < 0.3, (seed, cand.kind)
+            # No better than chance: the agreement beyond what these two
+            # performances' own symbol frequencies give is not significant.
+            assert summ["verdict"]["p_value"] > 0.05 and summ["verdict"]["kappa"] < 0.4, (seed, cand.kind)
             assert not summ["verdict"]["same_piece"] and summ["verdict"]["reason"].startswith("not the same piece")
 
 
