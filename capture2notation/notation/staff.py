@@ -21,7 +21,21 @@ Layout (Hutchinson's conventions, as in Wolofsky 1974 ch. III):
   centre, low solid black;
 * a symbol's length is its duration (``beat_height`` pixels per beat); a
   bend is shown as ``×N`` (the contraction sign with its degree) at the
-  symbol's foot.
+  symbol's foot;
+* turns (DESIGN.md, "Facing and turns") are turn signs in the support
+  column of the foot they turn on (across both support columns on both
+  feet or in the air, as in Hutchinson Guest): a parallelogram whose ends
+  slant down towards the turn's direction (right: clockwise), with a pin
+  inside pointing the amount turned (up = none, right = a quarter turn
+  clockwise …) and the amount written beside it; a support symbol at the
+  same time keeps the outer half of the column, the turn the inner half;
+* after each turn a **front sign** beside the staff (left of the left
+  support column) shows the new room direction: a square with a pin
+  pointing the way the dancer now faces (up = the starting front), its
+  name written under it;
+* flight (``support air``) is a gap in the support columns, marked at both
+  ends by a short stroke, with its spring form (jump, hop, leap, assemblé,
+  sissonne) written in the gap.
 
 The geometry is computed once (:func:`staff_layout`, pure) and drawn by two
 thin back ends: hand-written SVG (one ``<g class="symbol">`` per symbol,
@@ -39,9 +53,19 @@ from xml.sax.saxutils import escape, quoteattr
 import numpy as np
 
 from ..errors import NotationError
+from .facing import feet_before, front_changes, room_direction, spring_form
 from .model import Score, Symbol
 
-__all__ = ["Glyph", "StaffLayout", "render_staff", "staff_layout", "svg_text", "symbol_outline"]
+__all__ = [
+    "FrontSign",
+    "Glyph",
+    "StaffLayout",
+    "render_staff",
+    "staff_layout",
+    "svg_text",
+    "symbol_outline",
+    "turn_outline",
+]
 
 _MARGIN_TOP = 70.0
 _MARGIN_BOTTOM = 50.0
@@ -69,6 +93,11 @@ class Glyph:
     dot_radius : float
         Radius of the middle-level dot, pixels (one column's, even for
         ``support`` which spans two).
+    label : str
+        Text drawn with the symbol: a turn's amount, a flight's spring form
+        (empty otherwise).
+    pin : float or None
+        A turn's pin, degrees clockwise from up (the amount turned).
     """
 
     index: int
@@ -77,6 +106,35 @@ class Glyph:
     centre: tuple
     foot: tuple
     dot_radius: float
+    label: str = ""
+    pin: float | None = None
+
+
+@dataclass(frozen=True)
+class FrontSign:
+    """The room direction faced after a turn, drawn beside the staff.
+
+    Attributes
+    ----------
+    centre : tuple of float
+        Pixel centre of the sign.
+    size : float
+        Side of its square, pixels.
+    front : Fraction
+        Full turns clockwise from the starting front (unwrapped).
+    room : str
+        Room direction faced (:data:`~capture2notation.notation.facing.ROOM_DIRECTIONS`).
+    """
+
+    centre: tuple
+    size: float
+    front: Fraction
+    room: str
+
+    @property
+    def pin(self) -> float:
+        """Degrees clockwise from up of the pin (the room direction)."""
+        return float(self.front % 1) * 360.0
 
 
 @dataclass
@@ -88,6 +146,7 @@ class StaffLayout:
     glyphs: list = field(default_factory=list)
     lines: list = field(default_factory=list)  # (x0, y0, x1, y1, stroke width)
     texts: list = field(default_factory=list)  # (x, y, text, size, anchor)
+    fronts: list = field(default_factory=list)  # FrontSign
 
 
 def _columns(score: Score) -> dict:
@@ -168,6 +227,60 @@ def symbol_outline(direction: str, x0: float, y0: float, x1: float, y1: float, s
     if direction not in shapes:
         raise NotationError(f"no staff shape for direction {direction!r}")
     return np.asarray(shapes[direction], dtype=float)
+
+
+def turn_outline(direction: str, x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
+    """Outline of a turn sign in a box: a parallelogram slanting to the turn's direction.
+
+    Parameters
+    ----------
+    direction : {'right', 'left'}
+    x0, x1, y0, y1 : float
+        As for :func:`symbol_outline` (``y0 > y1``).
+
+    Returns
+    -------
+    (4, 2) ndarray
+        The bottom and top edges run down towards `direction` (a right turn's
+        right corners are the lower ones).
+    """
+    h = y0 - y1
+    c = min(h / 4.0, 0.5 * (x1 - x0))
+    if direction == "right":
+        return np.asarray([(x0, y0 - c), (x1, y0), (x1, y1 + c), (x0, y1)], dtype=float)
+    if direction == "left":
+        return np.asarray([(x0, y0), (x1, y0 - c), (x1, y1), (x0, y1 + c)], dtype=float)
+    raise NotationError(f"no turn sign for direction {direction!r}; expected right or left")
+
+
+def _support_box(score: Score, s: Symbol, column_width: float, pad: float) -> tuple[float, float]:
+    """x range (from the centre line) of a turn or of a support symbol sharing its time with a turn."""
+    if s.is_turn:
+        feet = feet_before(score, s.end)
+        if any(a.is_air and a.start < s.end and s.start < a.end for a in score.symbols):
+            feet = frozenset({"right", "left"})
+        if feet == {"right"}:
+            return pad, column_width - pad
+        if feet == {"left"}:
+            return -column_width + pad, -pad
+        return -column_width + pad, column_width - pad
+    if s.part == "support":
+        return -column_width + pad, column_width - pad
+    k = 1 if s.part == "right_support" else -1
+    lo = (k - 1 if k > 0 else k) * column_width
+    return lo + pad, lo + column_width - pad
+
+
+def _share(box: tuple[float, float], inner: bool) -> tuple[float, float]:
+    """The inner (towards the centre line) or outer half of a box; a box across the centre halves in height."""
+    x0, x1 = box
+    if x0 < 0 < x1:  # across both columns: the turn takes the middle, the support the sides
+        q = (x1 - x0) / 4
+        return (x0 + q, x1 - q) if inner else (x0, x1)
+    xm = 0.5 * (x0 + x1)
+    near_centre = (x0, xm) if x0 >= 0 else (xm, x1)
+    far = (xm, x1) if x0 >= 0 else (x0, xm)
+    return near_centre if inner else far
 
 
 def _clip_band(points: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -274,21 +387,38 @@ def staff_layout(
     lay.texts.append((width / 2, 46, sub, 11, "middle"))
 
     pad = _PAD * column_width
+    turns = [s for s in score.symbols if s.is_turn]
     for i, s in enumerate(score.symbols):
         # Outline in continuous coordinates (x from the centre line, y = −beats·px),
         # then cut at the staff breaks and moved onto each staff.
-        if s.part == "support":
-            x0, x1, side = -column_width + pad, column_width - pad, "right"
+        label, pin = "", None
+        if s.is_turn or s.is_support:
+            x0, x1 = _support_box(score, s, column_width, pad)
+            side = "right" if x1 > 0 else "left"
+            if s.is_turn and any(
+                u.is_support and not u.is_air and u.start < s.end and s.start < u.end for u in score.symbols
+            ):
+                x0, x1 = _share((x0, x1), inner=True)
+            elif s.is_support and not s.is_air and any(t.start < s.end and s.start < t.end for t in turns):
+                x0, x1 = _share((x0, x1), inner=False)
         else:
             k = cols[s.part]
             lo = (k - 1 if k > 0 else k) * column_width
             x0, x1, side = lo + pad, lo + column_width - pad, "right" if k > 0 else "left"
         yv0, yv1 = -float(s.start) * beat_height, -float(s.end) * beat_height
-        outline = symbol_outline(s.direction, x0, yv0, x1, yv1, side)
+        if s.is_turn:
+            outline = turn_outline(s.direction, x0, yv0, x1, yv1)
+            label = f"{'R' if s.direction == 'right' else 'L'} {s.amount}"
+            pin = float(s.signed_amount % 1) * 360.0
+        elif s.is_air:
+            outline = np.empty((0, 2))
+            label = spring_form(score, s) or "air"
+        else:
+            outline = symbol_outline(s.direction, x0, yv0, x1, yv1, side)
         j0 = min(int(s.start // staff_beats), n_staves - 1)
         j1 = min(int((s.end - Fraction(1, 10**9)) // staff_beats), n_staves - 1)
         pieces = []
-        for j in range(j0, j1 + 1):
+        for j in range(j0, j1 + 1) if len(outline) else ():
             band_lo = -float(min(s.end, (j + 1) * staff_beats)) * beat_height
             band_hi = -float(max(s.start, j * staff_beats)) * beat_height
             piece = _clip_band(outline, band_lo, band_hi) if j0 != j1 else outline
@@ -297,7 +427,22 @@ def staff_layout(
         jm = min(int(mid // staff_beats), n_staves - 1)
         dot = (centre(jm) + (x0 + x1) / 2, y(mid, jm))
         foot = (centre(j0) + (x0 + x1) / 2, y(s.start, j0))
-        lay.glyphs.append(Glyph(i, s, tuple(pieces), dot, foot, 0.1 * column_width))
+        lay.glyphs.append(Glyph(i, s, tuple(pieces), dot, foot, 0.1 * column_width, label, pin))
+        if s.is_air:
+            # The gap's ends: short strokes across the support columns.
+            for b in (s.start, s.end):
+                jb = min(int(b // staff_beats), n_staves - 1)
+                if b == s.end and b % staff_beats == 0 and b > 0:
+                    jb = min(int(b // staff_beats) - 1, n_staves - 1)
+                cx = centre(jb)
+                lay.lines.append((cx - 0.7 * column_width, y(b, jb), cx + 0.7 * column_width, y(b, jb), 0.8))
+    size = 0.7 * column_width
+    for t, front in front_changes(score):
+        j = min(int(t.end // staff_beats), n_staves - 1)
+        if t.end % staff_beats == 0 and t.end > 0:
+            j = min(int(t.end // staff_beats) - 1, n_staves - 1)
+        cx = centre(j) - n_left * column_width - 0.5 * size - 6
+        lay.fronts.append(FrontSign((cx, y(t.end, j) - 0.5 * size - 2), size, front, room_direction(front)))
     return lay
 
 
@@ -317,21 +462,54 @@ def _xml_text(text: str) -> str:
     return escape(_XML_INVALID.sub("\ufffd", text))
 
 
+def _pin_end(cx: float, cy: float, deg: float, r: float) -> tuple[float, float]:
+    """Point at `r` pixels from (cx, cy), `deg` degrees clockwise from up (y grows down)."""
+    a = np.radians(deg)
+    return cx + r * float(np.sin(a)), cy - r * float(np.cos(a))
+
+
 def _glyph_svg(g: Glyph) -> str:
     s = g.symbol
-    fill = {"high": "url(#hatch)", "middle": "white", "low": "black"}[s.level]
+    level = s.level or "none"
+    fill = {"high": "url(#hatch)", "middle": "white", "low": "black", "none": "white"}[level]
     attrs = (
-        f'id="sym-{g.index}" class="symbol part-{s.part} dir-{s.direction} level-{s.level}" '
-        f'data-part="{s.part}" data-direction="{s.direction}" data-level="{s.level}" '
+        f'id="sym-{g.index}" class="symbol part-{s.part} dir-{s.direction} level-{level}" '
+        f'data-part="{s.part}" data-direction="{s.direction}" data-level="{s.level or ""}" '
         f'data-bend="{s.bend}" data-start="{s.start}" data-duration="{s.duration}"'
     )
-    out = [f"<g {attrs}>", f"<title>{escape(f'{s.part} {s.direction} {s.level} beat {s.start}+{s.duration}')}</title>"]
+    if s.amount is not None:
+        attrs += f' data-amount="{s.amount}"'
+    if s.is_air:
+        attrs += f' data-spring="{g.label}"'
+    what = f"{s.part} {s.direction} {s.level or ''}".rstrip()
+    if s.amount is not None:
+        what += f" amount={s.amount}"
+    if s.is_air:
+        what += f" ({g.label})"
+    out = [f"<g {attrs}>", f"<title>{escape(f'{what} beat {s.start}+{s.duration}')}</title>"]
     for piece in g.pieces:
         pts = " ".join(f"{x:.2f},{y:.2f}" for x, y in piece)
         out.append(f'<polygon class="outline" points="{pts}" fill="{fill}" stroke="black" stroke-width="1.5"/>')
     if s.level == "middle":
         cx, cy = g.centre
         out.append(f'<circle class="dot" cx="{cx:.2f}" cy="{cy:.2f}" r="{g.dot_radius:.2f}" fill="black"/>')
+    if g.pin is not None:
+        cx, cy = g.centre
+        r = 2.2 * g.dot_radius
+        tx, ty = _pin_end(cx, cy, g.pin, r)
+        out.append(
+            f'<line class="pin" x1="{cx:.2f}" y1="{cy:.2f}" x2="{tx:.2f}" y2="{ty:.2f}" stroke="black" '
+            f'stroke-width="1.4"/><circle cx="{tx:.2f}" cy="{ty:.2f}" r="1.8" fill="black"/>'
+        )
+    if g.label:
+        cx, cy = g.foot if s.is_turn else g.centre
+        dy = -4.0 if s.is_turn else 3.0
+        style = ' font-style="italic"' if s.is_air else ""
+        cls = "amount" if s.is_turn else "spring"
+        out.append(
+            f'<text class="{cls}" x="{cx:.2f}" y="{cy + dy:.2f}" font-size="9" text-anchor="middle" '
+            f'font-family="sans-serif"{style}>{escape(g.label)}</text>'
+        )
     if s.bend:
         bx, by = g.foot[0], g.foot[1] - 3
         out.append(
@@ -342,6 +520,22 @@ def _glyph_svg(g: Glyph) -> str:
         )
     out.append("</g>")
     return "".join(out)
+
+
+def _front_svg(f: FrontSign) -> str:
+    cx, cy = f.centre
+    h = f.size / 2
+    tx, ty = _pin_end(cx, cy, f.pin, 0.8 * h)
+    return (
+        f'<g class="front-sign" data-front="{f.front}" data-room="{f.room}">'
+        f"<title>front: {f.room} ({f.front} turns)</title>"
+        f'<rect x="{cx - h:.2f}" y="{cy - h:.2f}" width="{f.size:.2f}" height="{f.size:.2f}" fill="white" '
+        'stroke="black" stroke-width="1"/>'
+        f'<line x1="{cx:.2f}" y1="{cy:.2f}" x2="{tx:.2f}" y2="{ty:.2f}" stroke="black" stroke-width="1.6"/>'
+        f'<circle cx="{tx:.2f}" cy="{ty:.2f}" r="2" fill="black"/>'
+        f'<text x="{cx:.2f}" y="{cy + h + 9:.2f}" font-size="7" text-anchor="middle" '
+        f'font-family="sans-serif">{escape(f.room)}</text></g>'
+    )
 
 
 def svg_text(lay: StaffLayout) -> str:
@@ -367,6 +561,9 @@ def svg_text(lay: StaffLayout) -> str:
     parts.append("</g>")
     parts.append('<g class="symbols">')
     parts += [_glyph_svg(g) for g in lay.glyphs]
+    parts.append("</g>")
+    parts.append('<g class="fronts">')
+    parts += [_front_svg(f) for f in lay.fronts]
     parts.append("</g></svg>")
     return "\n".join(parts) + "\n"
 
@@ -404,7 +601,7 @@ def _render_png(lay: StaffLayout, path, dpi: int) -> None:
     with matplotlib.rc_context({"hatch.linewidth": 1.2}):
         for g in lay.glyphs:
             s = g.symbol
-            face = {"high": "white", "middle": "white", "low": "black"}[s.level]
+            face = {"high": "white", "middle": "white", "low": "black", None: "white"}[s.level]
             for piece in g.pieces:
                 ax.add_patch(
                     Polygon(
@@ -418,10 +615,34 @@ def _render_png(lay: StaffLayout, path, dpi: int) -> None:
                 )
             if s.level == "middle":
                 ax.add_patch(Circle(g.centre, g.dot_radius, color="black"))
+            if g.pin is not None:
+                tx, ty = _pin_end(g.centre[0], g.centre[1], g.pin, 2.2 * g.dot_radius)
+                ax.plot([g.centre[0], tx], [g.centre[1], ty], color="black", lw=1.4 * pt)
+                ax.add_patch(Circle((tx, ty), 1.8, color="black"))
+            if g.label:
+                cx, cy = g.foot if s.is_turn else g.centre
+                ax.text(
+                    cx,
+                    cy + (-4.0 if s.is_turn else 3.0),
+                    g.label,
+                    fontsize=9 * pt,
+                    ha="center",
+                    va="baseline",
+                    style="italic" if s.is_air else "normal",
+                    parse_math=False,
+                )
             if s.bend:
                 bx, by = g.foot[0], g.foot[1] - 3
                 ax.add_patch(Rectangle((bx - 9, by - 11), 18, 12, facecolor="white", edgecolor="black", lw=0.5))
                 ax.text(bx, by - 1.5, f"\u00d7{s.bend}", fontsize=10 * pt, ha="center", va="baseline")
+        for f in lay.fronts:
+            cx, cy = f.centre
+            h = f.size / 2
+            ax.add_patch(Rectangle((cx - h, cy - h), f.size, f.size, facecolor="white", edgecolor="black", lw=0.7))
+            tx, ty = _pin_end(cx, cy, f.pin, 0.8 * h)
+            ax.plot([cx, tx], [cy, ty], color="black", lw=1.6 * pt)
+            ax.add_patch(Circle((tx, ty), 2.0, color="black"))
+            ax.text(cx, cy + h + 9, f.room, fontsize=7 * pt, ha="center", va="baseline", parse_math=False)
         with atomic_path(path, suffix=".png") as tmp:
             fig.savefig(tmp, format="png", dpi=dpi)
 
