@@ -13,6 +13,7 @@ line.  The default tier draws a few hundred inputs per reader; the slow tier
 
 from __future__ import annotations
 
+import copy
 import json
 from fractions import Fraction
 
@@ -237,7 +238,8 @@ def _mutate_tree(draw, tree):
                 value = [value]
             parent[path[-1]] = value
         else:
-            parent[path[-1]] = draw(st.sampled_from(NASTY_JSON) | st.text(max_size=6) | st.integers())
+            # A copy: later mutations must not change the shared constants.
+            parent[path[-1]] = copy.deepcopy(draw(st.sampled_from(NASTY_JSON) | st.text(max_size=6) | st.integers()))
     return tree
 
 
