@@ -35,6 +35,7 @@ fractions), and every figure below is in reference beats.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass, replace
 from fractions import Fraction
@@ -43,7 +44,7 @@ import numpy as np
 
 from ..errors import CompareError
 from ..notation.directions import canonical_vector, classify
-from ..notation.facing import spring_form
+from ..notation.facing import springs
 from ..notation.model import GESTURE_PARTS, Score, Symbol
 
 __all__ = [
@@ -99,17 +100,30 @@ def _support_transitions(symbols) -> list:
     other foot over the ended symbol's span."""
     syms = list(symbols)
     feet = [s for s in syms if s.part in ("right_support", "left_support")]
-    out = [s for s in syms if s not in feet]
+    foot_ids = {id(s) for s in feet}
+    out = [s for s in syms if id(s) not in foot_ids]
+    # One foot's symbols never overlap, so the other foot's symbol that could
+    # contain s is the last one starting at or before s (found by bisection).
+    by_part = {
+        p: sorted((t for t in feet if t.part == p), key=lambda t: t.start) for p in ("right_support", "left_support")
+    }
+    starts = {p: [t.start for t in ts] for p, ts in by_part.items()}
     used = set()
     for s in feet:
-        for t in feet:
-            if t.part != s.part and t.start <= s.start and s.end < t.end and id(s) not in used:
-                # s ends first while t still supports: weight onto t's foot.
-                used.add(id(s))
-                if t.start < s.start:
-                    continue
-                used.add(id(t))
-                out.append(Symbol(s.start, s.duration, t.part, t.direction, t.level, 0))
+        if id(s) in used:
+            continue
+        other = "left_support" if s.part == "right_support" else "right_support"
+        k = bisect.bisect_right(starts[other], s.start)
+        if k == 0:
+            continue
+        t = by_part[other][k - 1]
+        if s.end < t.end:
+            # s ends first while t still supports: weight onto t's foot.
+            used.add(id(s))
+            if t.start < s.start:
+                continue
+            used.add(id(t))
+            out.append(Symbol(s.start, s.duration, t.part, t.direction, t.level, 0))
     out += [s for s in feet if id(s) not in used]
     return out
 
@@ -213,7 +227,7 @@ def state_at(score: Score, part: str, beats) -> list[tuple]:
     forms = {}
     if part == "supports":
         syms = [s for s in score.symbols if s.is_support]
-        forms = {id(s): spring_form(score, s) for s in syms if s.is_air}
+        forms = {id(a): form for a, form in springs(score)}
         cur = DEFAULT_SUPPORT
     else:
         family = _FAMILY.get(part, (part,))
@@ -382,15 +396,21 @@ def start_errors(ref: Score, cand: Score) -> tuple[np.ndarray, int]:
         Reference gesture symbols with no such captured symbol.
     """
     ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
+    index: dict[tuple, list] = {}
+    for c in cand.symbols:
+        index.setdefault(_what(c), []).append(c.start)
+    for starts in index.values():
+        starts.sort()
     errs, missing = [], 0
     for s in ref.symbols:
         if s.is_support:
             continue
-        starts = [c.start for c in cand.symbols if _what(c) == _what(s)]
+        starts = index.get(_what(s), [])
         if not starts:
             missing += 1
             continue
-        errs.append(float(min(abs(c - s.start) for c in starts)))
+        k = bisect.bisect_left(starts, s.start)
+        errs.append(float(min(abs(starts[j] - s.start) for j in (k - 1, k) if 0 <= j < len(starts))))
     return np.asarray(errs, dtype=float), missing
 
 

@@ -23,18 +23,23 @@ without one the form is undefined (None), e.g. a clip that ends in the air.
 
 from __future__ import annotations
 
+import bisect
+import itertools
 from fractions import Fraction
 
-from .model import SUPPORT_PARTS, TURN_STEP, Score, Symbol
+from .model import TURN_STEP, Score, Symbol
 
 __all__ = [
     "FOOT_OF_SUPPORT",
     "ROOM_DIRECTIONS",
     "SPRING_FORMS",
+    "Intervals",
+    "SupportIndex",
     "feet_before",
     "feet_landing",
     "front_at",
     "front_changes",
+    "front_lookup",
     "room_direction",
     "spring_form",
     "springs",
@@ -58,20 +63,56 @@ ROOM_DIRECTIONS: tuple[str, ...] = (
 _LEG_PARTS = {foot: (f"{foot}_leg", f"{foot}_thigh", f"{foot}_shin") for foot in ("right", "left")}
 
 
+class Intervals:
+    """Spans of beats, asked whether any overlaps a given span (in O(log n)).
+
+    Parameters
+    ----------
+    spans : iterable of (start, end)
+        Any order; spans may overlap one another.
+    """
+
+    def __init__(self, spans):
+        spans = sorted(spans)
+        self.starts = [a for a, _ in spans]
+        self.max_end = list(itertools.accumulate((b for _, b in spans), max))
+
+    def overlaps(self, start, end) -> bool:
+        """Whether a span with ``s < end`` and ``e > start`` exists."""
+        k = bisect.bisect_left(self.starts, end)
+        return k > 0 and self.max_end[k - 1] > start
+
+
+def _turns(score: Score) -> tuple[list[Symbol], list[Fraction]]:
+    """Turns in time order with the front once each has ended (turns never overlap)."""
+    turns = [s for s in score.symbols if s.is_turn]
+    return turns, list(itertools.accumulate((t.signed_amount for t in turns), initial=Fraction(0)))[1:]
+
+
 def front_at(score: Score, beat) -> Fraction:
     """Front at `beat`, full turns clockwise from the start (turns in progress count in part).
 
     A turn in progress is counted linearly over its span; notation does not
     say how a turn is eased, so only the fronts between turns are exact.
     """
-    beat = Fraction(beat)
-    total = Fraction(0)
-    for s in score.symbols:
-        if not s.is_turn or s.start >= beat:
-            continue
-        part = min(Fraction(1), (beat - s.start) / s.duration)
-        total += part * s.signed_amount
-    return total
+    return front_lookup(score)(beat)
+
+
+def front_lookup(score: Score):
+    """``beat -> front`` for many beats of one score (sorted turns, bisection)."""
+    turns, fronts = _turns(score)
+    starts = [t.start for t in turns]
+
+    def at(beat) -> Fraction:
+        beat = Fraction(beat)
+        k = bisect.bisect_left(starts, beat)  # turns starting before `beat`
+        if k == 0:
+            return Fraction(0)
+        t, before = turns[k - 1], fronts[k - 2] if k >= 2 else Fraction(0)
+        part = min(Fraction(1), (beat - t.start) / t.duration)
+        return before + part * t.signed_amount
+
+    return at
 
 
 def front_changes(score: Score) -> list[tuple[Symbol, Fraction]]:
@@ -80,14 +121,10 @@ def front_changes(score: Score) -> list[tuple[Symbol, Fraction]]:
     Returns
     -------
     list of (Symbol, Fraction)
-        In score order.  Overlapping turns (not a notation one writes) add up.
+        In score order.
     """
-    turns = [s for s in score.symbols if s.is_turn]
-    out = []
-    for t in turns:
-        front = sum((u.signed_amount for u in turns if u.end <= t.end), Fraction(0))
-        out.append((t, front))
-    return out
+    turns, fronts = _turns(score)
+    return list(zip(turns, fronts))
 
 
 def room_direction(front) -> str:
@@ -96,32 +133,61 @@ def room_direction(front) -> str:
     return ROOM_DIRECTIONS[eighths % 8]
 
 
+class SupportIndex:
+    """The supports and leg gestures of a score, indexed once for many queries.
+
+    :meth:`before` is :func:`feet_before`, :meth:`landing` the feet a
+    landing at a beat names, :meth:`form` :func:`spring_form` — each in
+    O(log n) after an O(n log n) build.
+    """
+
+    def __init__(self, score: Score):
+        sups = sorted((s for s in score.symbols if s.is_support and not s.is_air), key=lambda s: s.end)
+        self.ends = [s.end for s in sups]
+        self.named: dict[Fraction, set] = {}
+        self.starting: dict[Fraction, set] = {}
+        for s in sups:
+            self.named.setdefault(s.end, set()).update(FOOT_OF_SUPPORT[s.part])
+            self.starting.setdefault(s.start, set()).update(FOOT_OF_SUPPORT[s.part])
+        self.legs = {
+            foot: Intervals((s.start, s.end) for s in score.symbols if s.part in parts)
+            for foot, parts in _LEG_PARTS.items()
+        }
+
+    def before(self, beat) -> frozenset:
+        beat = Fraction(beat)
+        k = bisect.bisect_right(self.ends, beat)
+        if k:
+            t_ref = self.ends[k - 1]
+            named = self.named[t_ref]
+        else:
+            t_ref, named = Fraction(0), {"right", "left"}
+        # A leg gesture begun before `beat` and still going after the support lifts its foot.
+        lifted = {foot for foot, legs in self.legs.items() if legs.overlaps(t_ref, beat)}
+        return frozenset(named - lifted)
+
+    def landing(self, beat) -> frozenset:
+        return frozenset(self.starting.get(Fraction(beat), ()))
+
+    def form(self, air: Symbol) -> str | None:
+        before, after = self.before(air.start), self.landing(air.end)
+        if not before or not after:
+            return None
+        if len(before) == 2:
+            return "jump" if len(after) == 2 else "sissonne"
+        if len(after) == 2:
+            return "assemblé"
+        return "hop" if before == after else "leap"
+
+
 def feet_before(score: Score, beat) -> frozenset:
     """Feet on the floor just before `beat` (see the module docstring)."""
-    beat = Fraction(beat)
-    prior = [s for s in score.symbols if s.is_support and not s.is_air and s.end <= beat]
-    if prior:
-        t_ref = max(s.end for s in prior)
-        named = {f for s in prior if s.end == t_ref for f in FOOT_OF_SUPPORT[s.part]}
-    else:
-        t_ref, named = Fraction(0), {"right", "left"}
-    lifted = {
-        foot
-        for foot, legs in _LEG_PARTS.items()
-        for s in score.symbols
-        if s.part in legs and s.start < beat and s.end > t_ref
-    }
-    return frozenset(named - lifted)
+    return SupportIndex(score).before(beat)
 
 
 def feet_landing(score: Score, air: Symbol) -> frozenset:
     """Feet named by the support symbols that start where flight `air` ends."""
-    return frozenset(
-        f
-        for s in score.symbols
-        if s.part in SUPPORT_PARTS and not s.is_air and s.start == air.end
-        for f in FOOT_OF_SUPPORT[s.part]
-    )
+    return SupportIndex(score).landing(air.end)
 
 
 def spring_form(score: Score, air: Symbol) -> str | None:
@@ -131,18 +197,13 @@ def spring_form(score: Score, air: Symbol) -> str | None:
     -------
     str or None
         One of :data:`SPRING_FORMS`; None without a landing or with no foot on
-        the floor before (flight straight after flight).
+        the floor before (flight straight after flight).  For every flight of
+        a score at once, :func:`springs` indexes the score only once.
     """
-    before, after = feet_before(score, air.start), feet_landing(score, air)
-    if not before or not after:
-        return None
-    if len(before) == 2:
-        return "jump" if len(after) == 2 else "sissonne"
-    if len(after) == 2:
-        return "assemblé"
-    return "hop" if before == after else "leap"
+    return SupportIndex(score).form(air)
 
 
 def springs(score: Score) -> list[tuple[Symbol, str | None]]:
     """Every flight of `score` with its spring form, in score order."""
-    return [(s, spring_form(score, s)) for s in score.symbols if s.is_air]
+    index = SupportIndex(score)
+    return [(s, index.form(s)) for s in score.symbols if s.is_air]

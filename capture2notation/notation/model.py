@@ -390,15 +390,21 @@ class Score:
             last_end[s.part] = s.end
         airs = [s for s in self.symbols if s.is_air]
         if airs:
-            # Flight bears no weight: no support of either foot may overlap it.
+            # Flight bears no weight: no support of either foot may overlap it
+            # (a sweep over both kinds in start order, not every pair).
             sups = [s for s in self.symbols if s.part in ("right_support", "left_support")]
-            for a in airs:
-                for s in sups:
-                    if s.start < a.end and a.start < s.end:
-                        raise NotationError(
-                            f"{s.part} at beat {s.start}-{s.end} overlaps support air at beat {a.start}-{a.end}; "
-                            "no foot bears weight in flight"
-                        )
+            events = sorted([(s.start, 0, s) for s in sups] + [(a.start, 1, a) for a in airs], key=lambda e: e[:2])
+            last: dict[int, Symbol] = {}
+            for _, kind, s in events:
+                other = last.get(1 - kind)
+                if other is not None and other.end > s.start:
+                    foot, air = (s, other) if kind == 0 else (other, s)
+                    raise NotationError(
+                        f"{foot.part} at beat {foot.start}-{foot.end} overlaps support air at beat "
+                        f"{air.start}-{air.end}; no foot bears weight in flight"
+                    )
+                if kind not in last or s.end > last[kind].end:
+                    last[kind] = s
 
     @property
     def duration(self) -> Fraction:

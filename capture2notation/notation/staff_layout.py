@@ -52,7 +52,7 @@ from fractions import Fraction
 import numpy as np
 
 from ..errors import NotationError
-from .facing import feet_before, front_changes, room_direction, spring_form
+from .facing import Intervals, SupportIndex, front_changes, room_direction, springs
 from .model import Score, Symbol
 
 __all__ = [
@@ -250,12 +250,9 @@ def turn_outline(direction: str, x0: float, y0: float, x1: float, y1: float) -> 
     raise NotationError(f"no turn sign for direction {direction!r}; expected right or left")
 
 
-def _support_box(score: Score, s: Symbol, column_width: float, pad: float) -> tuple[float, float]:
-    """x range (from the centre line) of a turn or of a support symbol sharing its time with a turn."""
+def _support_box(s: Symbol, feet: frozenset, column_width: float, pad: float) -> tuple[float, float]:
+    """x range (from the centre line) of a support or turn symbol; a turn's by the `feet` it turns on."""
     if s.is_turn:
-        feet = feet_before(score, s.end)
-        if any(a.is_air and a.start < s.end and s.start < a.end for a in score.symbols):
-            feet = frozenset({"right", "left"})
         if feet == {"right"}:
             return pad, column_width - pad
         if feet == {"left"}:
@@ -384,19 +381,24 @@ def staff_layout(
     lay.texts.append((width / 2, 46, sub, 11, "middle"))
 
     pad = _PAD * column_width
-    turns = [s for s in score.symbols if s.is_turn]
+    # Indexed once: which feet a turn is on, what overlaps what (no pairwise scans).
+    index = SupportIndex(score)
+    forms = {a.start: form for a, form in springs(score)}
+    air_spans = Intervals((a.start, a.end) for a in score.symbols if a.is_air)
+    turn_spans = Intervals((t.start, t.end) for t in score.symbols if t.is_turn)
+    support_spans = Intervals((u.start, u.end) for u in score.symbols if u.is_support and not u.is_air)
     for i, s in enumerate(score.symbols):
         # Outline in continuous coordinates (x from the centre line, y = −beats·px),
         # then cut at the staff breaks and moved onto each staff.
         label, pin = "", None
         if s.is_turn or s.is_support:
-            x0, x1 = _support_box(score, s, column_width, pad)
+            in_air = s.is_turn and air_spans.overlaps(s.start, s.end)
+            feet = frozenset({"right", "left"}) if in_air or not s.is_turn else index.before(s.end)
+            x0, x1 = _support_box(s, feet, column_width, pad)
             side = "right" if x1 > 0 else "left"
-            if s.is_turn and any(
-                u.is_support and not u.is_air and u.start < s.end and s.start < u.end for u in score.symbols
-            ):
+            if s.is_turn and support_spans.overlaps(s.start, s.end):
                 x0, x1 = _share((x0, x1), inner=True)
-            elif s.is_support and not s.is_air and any(t.start < s.end and s.start < t.end for t in turns):
+            elif s.is_support and not s.is_air and turn_spans.overlaps(s.start, s.end):
                 x0, x1 = _share((x0, x1), inner=False)
         else:
             k = cols[s.part]
@@ -409,7 +411,7 @@ def staff_layout(
             pin = float(s.signed_amount % 1) * 360.0
         elif s.is_air:
             outline = np.empty((0, 2))
-            label = spring_form(score, s) or "air"
+            label = forms[s.start] or "air"
         else:
             outline = symbol_outline(s.direction, x0, yv0, x1, yv1, side)
         j0 = min(int(s.start // staff_beats), n_staves - 1)

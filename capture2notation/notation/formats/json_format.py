@@ -38,7 +38,7 @@ from fractions import Fraction
 from typing import Any, NoReturn
 
 from ...errors import NotationError, ScoreFormatError
-from ..facing import spring_form
+from ..facing import springs
 from ..limits import MAX_SCORE_BYTES, MAX_SYMBOLS
 from ..model import AXES, EMOTIONS, Effort, Score, Symbol, as_fraction
 from .lab import format_fraction
@@ -60,6 +60,7 @@ def _tempo_json(tempo: Fraction):
 def score_to_dict(score: Score) -> dict:
     """Plain JSON-serialisable dict of `score` (see the module docstring)."""
     e = score.effort
+    forms = {a.start: form for a, form in springs(score)}  # flights never overlap: one per start
     return {
         "format": FORMAT_TAG,
         "version": VERSION,
@@ -69,11 +70,11 @@ def score_to_dict(score: Score) -> dict:
         "effort": None if e is None else {"time": e.time, "weight": e.weight, "space": e.space},
         "emotion": score.emotion,
         "axes": score.axes,
-        "symbols": [_symbol_dict(score, s) for s in score.symbols],
+        "symbols": [_symbol_dict(forms, s) for s in score.symbols],
     }
 
 
-def _symbol_dict(score: Score, s: Symbol) -> dict:
+def _symbol_dict(forms: dict, s: Symbol) -> dict:
     out: dict[str, Any] = {
         "start": format_fraction(s.start),
         "duration": format_fraction(s.duration),
@@ -85,7 +86,7 @@ def _symbol_dict(score: Score, s: Symbol) -> dict:
     if s.amount is not None:
         out["amount"] = format_fraction(s.amount)
     if s.is_air:
-        out["spring"] = spring_form(score, s)
+        out["spring"] = forms[s.start]
     return out
 
 
@@ -229,12 +230,13 @@ def score_from_dict(data, path: str | None = None) -> Score:
     except NotationError as exc:
         msg = str(exc)
         where.fail("symbols" if "starts before" in msg or "overlaps" in msg else _field_of(msg), msg)
+    forms = {a.start: form for a, form in springs(score)}
     for i, item in enumerate(symbols):
         if "spring" in item and item["spring"] is not None:
             sym = syms[i]
             if not sym.is_air:
                 where.fail(f"symbols[{i}].spring", "only support air has a spring form")
-            got = spring_form(score, sym)
+            got = forms[sym.start]
             if item["spring"] != got:
                 where.fail(
                     f"symbols[{i}].spring",

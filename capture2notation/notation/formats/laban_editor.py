@@ -70,7 +70,7 @@ import numpy as np
 
 from ...errors import NotationError, ScoreFormatError
 from ..directions import BEND_STEP_DEG, canonical_vector, classify
-from ..facing import front_at
+from ..facing import front_lookup
 from ..limits import MAX_NUMBER_CHARS, MAX_SYMBOLS
 from ..model import TURN_PART, TURN_STEP, Score, Symbol
 from .json_format import load_json
@@ -175,6 +175,7 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
     # Apply symbols in order of arrival; a later symbol on a segment wins.
     events = sorted(relevant, key=lambda s: (s.end, s.start))
     state = dict(_START)
+    front_at = front_lookup(score)
     positions: dict = {}
     k = 0
     prev_ms = 0
@@ -193,7 +194,7 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
         for field, part, _, _ in _FIELDS:
             d, lv = state[part]
             pose[field] = [DIRECTION_NAMES[d], LEVEL_NAMES[lv]]
-        pose["rotation"] = _rotation(front_at(score, t))
+        pose["rotation"] = _rotation(front_at(t))
         positions[f"Position{len(positions)}"] = pose
         prev_ms = ms
     return {name or score.title or "score": positions}
