@@ -49,9 +49,17 @@ class ScoreFormatError(NotationError):
         The file, when known.
     line : int or None
         1-based line number, when known.
+
+    A message longer than :data:`MAX_MESSAGE_CHARS` (a bad token quoted from
+    a hostile file) is cut there, so the error stays one readable line.
     """
 
+    #: Longest message kept, characters.
+    MAX_MESSAGE_CHARS = 300
+
     def __init__(self, message: str, path: str | None = None, line: int | None = None):
+        if len(message) > self.MAX_MESSAGE_CHARS:
+            message = message[: self.MAX_MESSAGE_CHARS - 1] + "…"
         self.path = path
         self.line = line
         where = ""

@@ -501,7 +501,8 @@ def index_html(result: CaptureResult) -> str:
     score = result.score
     rows = "\n".join(
         f"<tr><td>{s.start}</td><td>{s.duration}</td><td>{html.escape(s.part)}</td>"
-        f"<td>{html.escape(s.direction)}</td><td>{html.escape(s.level)}</td><td>{s.bend or ''}</td></tr>"
+        f"<td>{html.escape(s.direction)}</td><td>{html.escape(s.level or '')}</td>"
+        f"<td>{s.bend or (f'amount={s.amount}' if s.amount is not None else '')}</td></tr>"
         for s in score.symbols
     )
     video = (

@@ -39,6 +39,7 @@ PART_JOINTS = {
     "support": ("right_hip", "right_knee", "right_ankle", "left_hip", "left_knee", "left_ankle"),
     "right_support": ("right_hip", "right_knee", "right_ankle"),
     "left_support": ("left_hip", "left_knee", "left_ankle"),
+    "turn": ("pelvis",),
 }
 #: |ry| this close to 90° (radians) is a gimbal lock (matrix_to_euler's
 #: test, |sin ry| > 1 − 1e-9, in angle).
@@ -110,7 +111,7 @@ def keep_paths_within(angles: np.ndarray, body: Body, events, eff: Effort) -> np
     :mod:`synthetic.reach`'s to report.
     """
     for sym, f0, f1 in events:
-        if sym.is_support or f1 <= f0 + 1:
+        if sym.is_support or sym.is_turn or f1 <= f0 + 1:
             continue
         js = [joint_index(n) for n in PART_JOINTS[sym.part]]
         way = np.arange(f0 + 1, f1)

@@ -15,6 +15,18 @@ Semantics (``../shared/DESIGN.md``; Wolofsky 1974 ch. IV; Neagle 2005 ch. 5):
 * Supports place the feet and carry the weight (:mod:`synthetic.supports`);
   a step or a landing foot touches down on the symbol's end frame and the
   weight arrives with it, so supports arrive at the end like gestures.
+* Turns (``turn right|left amount=F``) change the front with the Effort
+  progress over their span, pivoting about the supporting foot or feet, or
+  about the pelvis in the air (:mod:`synthetic.turning`); every direction
+  — limbs and steps — is relative to the current front.  Flight
+  (``support air``) is a ballistic pelvis between take-off and touchdown,
+  landing into the level of the support symbol that starts where it ends
+  (:mod:`synthetic.flight`).
+* The score's key: with ``axes: body``, arm and head directions are read in
+  the body cross of axes (the plane of the shoulders and the mid-spine,
+  :func:`capture2notation.body.body_cross`), so they tilt with the torso;
+  chest and legs keep the standard cross (the torso cannot be read against
+  itself, and the body cross of LabanotationSuite is the arms').
 * Unnotated parts hold.  The start pose is standing on both feet, arms and
   legs hanging straight, head and chest upright.
 * Joint extremes: a whole limb's free twist keeps its bound joint inside
@@ -44,7 +56,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from capture2notation.body import Body, euler_to_matrix, joint_index
+from capture2notation.body import Body, body_cross, euler_to_matrix, forward_kinematics, joint_index
 from capture2notation.errors import SyntheticError
 from capture2notation.notation.model import Effort, Score
 
@@ -56,6 +68,7 @@ from .rotations import Z as _Z
 from .rotations import rot_between
 from .supports import PLIE_BEND_DEG, RELEVE_DEG, STEP_LENGTH, Support, leg_tracks
 from .trunk import chest_reach, direction_track, trunk_angles
+from .turning import front_track, place_in_room, turn_spans
 
 __all__ = ["PLIE_BEND_DEG", "RELEVE_DEG", "STEP_LENGTH", "UnreachableWarning", "beat_frame", "interpret", "unreachable"]
 
@@ -64,6 +77,20 @@ def beat_frame(beat, tempo, fps: float) -> int:
     """Frame index of a beat: round half up of ``beat × 60 / tempo × fps``."""
     x = float(Fraction(beat) * 60 / Fraction(tempo)) * fps
     return int(np.floor(x + 0.5 + 1e-9))
+
+
+def _key_to_pelvis(angles: np.ndarray, body: Body) -> np.ndarray:
+    """(T, 3, 3) body cross of axes in the pelvis frame (columns right, forward, up).
+
+    From the trunk's angles alone (the shoulders hang from the chest, the
+    waist from the pelvis), as :func:`capture2notation.body.body_cross`
+    reads it from the joints.
+    """
+    trunk = np.zeros_like(angles)
+    for name in ("waist", "chest"):
+        trunk[:, joint_index(name)] = angles[:, joint_index(name)]
+    J = forward_kinematics(trunk, np.zeros((len(angles), 3)), body)
+    return body_cross(J).transpose(0, 2, 1)
 
 
 def interpret(score: Score, fps: float = 25.0, body: Body | None = None, effort: Effort | None = None) -> Motion:
@@ -116,10 +143,14 @@ def interpret(score: Score, fps: float = 25.0, body: Body | None = None, effort:
     angles[:, joint_index("chest")] = ec
     Rchest = euler_to_matrix(ew) @ euler_to_matrix(ec)
     RchestT = Rchest.transpose(0, 2, 1)
+    # Arms and head are read in the score's key: the body cross turns their
+    # directions with the torso (key → pelvis frame), the standard one not.
+    key = _key_to_pelvis(angles, body) if score.axes == "body" else np.tile(np.eye(3), (T, 1, 1))
     head_d = direction_track(symbols, "head", frame, T, eff)
     ineck = joint_index("neck")
-    head_R = RchestT @ rot_between(_Z, head_d, [1.0, 0.0, 0.0])
+    head_R = RchestT @ key @ rot_between(_Z, head_d, [1.0, 0.0, 0.0])
     angles[:, ineck] = euler_near(head_R, 0.0, body.limits[ineck])
+    RchestT = RchestT @ key  # arms: key frame → chest-local
 
     for name in ("right_arm", "left_arm"):
         limb = Limb(name, body)
@@ -138,15 +169,21 @@ def interpret(score: Score, fps: float = 25.0, body: Body | None = None, effort:
     for name, (Q, beta, ankle) in leg_tracks(sup, symbols, frame, T, eff).items():
         limb = sup.limbs[name.split("_")[0]]
         ja, jm, jb = limb.joints
-        angles[:, ja] = euler_near(Q, 0.0, body.limits[ja])  # the pelvis never rotates
+        angles[:, ja] = euler_near(Q, 0.0, body.limits[ja])  # in the pelvis's (plan) frame
         angles[:, jm, 0] = limb.middle_angle(beta)
         angles[:, jb] = ankle
+    # Turns: the plan is placed in the room by the pelvis's yaw (rz = −front).
+    front = front_track(symbols, frame, T, eff)
+    turns = [(f0, f1, sup.pivot(s)) for s, f0, f1 in turn_spans(symbols, frame)]
+    root = place_in_room(sup.root, front, turns)
+    angles[:, 0] = 0.0
+    angles[:, 0, 2] = np.mod(-front + np.pi, 2 * np.pi) - np.pi
 
     events = tuple((s, frame(s.start), frame(s.end)) for s in symbols)
     # Legs were kept within their extremes before the floor was enforced.
     keep_paths_within(angles, body, [e for e in events if not e[0].part.endswith(("leg", "thigh", "shin"))], eff)
     continuous_at_lock(angles, body)
-    motion = Motion(fps, angles, sup.root, body, events)  # enforces the extremes
-    for u in reach_report(motion, angles):
+    motion = Motion(fps, angles, root, body, events)  # enforces the extremes
+    for u in reach_report(motion, angles, axes=score.axes):
         warnings.warn(u.message(), UnreachableWarning, stacklevel=2)
     return motion

@@ -30,7 +30,15 @@ from functools import reduce
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from capture2notation.body import JOINTS, Body, euler_to_matrix, forward_kinematics, joint_index, matrix_to_euler
+from capture2notation.body import (
+    JOINTS,
+    Body,
+    euler_to_matrix,
+    forward_kinematics,
+    joint_index,
+    matrix_to_euler,
+    rotation_front,
+)
 from capture2notation.errors import SyntheticError
 
 from .interpolate import easing
@@ -109,6 +117,18 @@ class Motion:
     def present(self) -> np.ndarray:
         """(J,) bool: joints this motion animates (not NaN in every frame)."""
         return ~np.all(np.isnan(self.angles), axis=(0, 2))
+
+    @property
+    def front(self) -> np.ndarray:
+        """(T,) front: degrees clockwise seen from above from the room's +y, unwrapped.
+
+        The pelvis's facing (DESIGN.md, "Facing and turns"): a right turn of
+        a half ends at +180, two right pirouettes at +720.  NaN where the
+        pelvis is absent.
+        """
+        out = rotation_front(euler_to_matrix(np.nan_to_num(self.angles[:, 0])))
+        out[np.isnan(self.angles[:, 0]).any(axis=-1)] = np.nan
+        return out
 
     def joints(self) -> np.ndarray:
         """World joint positions, (T, J, 3) metres (NaN below absent joints)."""

@@ -251,7 +251,126 @@ def _other(foot: str) -> str:
     return "left" if foot == "right" else "right"
 
 
-def _legs_track(rng, n_beats, bpm):
+#: Flight time of a random spring, seconds: long enough to see (issue 14
+#: asks captures to find flights of 0.3 s and more), low enough to be a
+#: dancer's (a 0.6 s flight rises 0.44 m).
+FLIGHT_S = (0.3, 0.6)
+#: Fastest turn on both feet, radians per second: each foot slides round the
+#: feet's midpoint (0.094 m away for a 1.70 m dancer) at under 0.14 m/s,
+#: slower than DESIGN.md's 0.2 m/s support speed.
+SWIVEL_RAD_S = 1.4
+#: Turns of a random pirouette (on one foot, in relevé) and of a turn in the
+#: air, in eighths of a turn (1/8 … 2 turns; 1/4 … 1 turn in the air).
+PIROUETTE_EIGHTHS = (1, 16)
+AIR_TURN_EIGHTHS = (2, 4, 8)
+#: Steps of a random walk (travel).
+WALK_STEPS = (2, 4)
+_SPRING_FORMS = ("jump", "hop", "leap", "assemblé", "sissonne")
+
+
+def _free_leg_targets(side: str) -> list:
+    """Low gestures of a free leg (retiré-like lifts and low extensions), for `side`."""
+    return [_side(x, side) for x in LEG_TARGETS if x[1] == "low"]
+
+
+def _pirouette(rng, t, end, slow, landed):
+    """A turn on one foot rising into relevé, the free leg lifted, then a closing."""
+    foot = ("right", "left")[int(rng.integers(2))] if landed is None else landed
+    free = _other(foot)
+    d = slow[int(rng.integers(len(slow)))]
+    close = slow[0]
+    if t + d + close > end:
+        return None
+    amount = Fraction(int(rng.integers(PIROUETTE_EIGHTHS[0], PIROUETTE_EIGHTHS[1] + 1)), 8)
+    turn = ("right", "left")[int(rng.integers(2))]
+    leg = _pick(rng, _free_leg_targets(free))
+    syms = [
+        Symbol(t, d, f"{foot}_support", "place", "high"),
+        Symbol(t, d, "turn", turn, None, amount=amount),
+        Symbol(t, d, f"{free}_leg", *leg),
+        Symbol(t + d, close, "support", "place", "middle"),
+    ]
+    return syms, t + d + close, free
+
+
+def _swivel(rng, t, end, bpm):
+    """A slow turn on both feet (an eighth or a quarter)."""
+    amount = Fraction(int(rng.integers(1, 3)), 8)
+    least = float(amount) * 2 * np.pi / SWIVEL_RAD_S
+    durs = [d for d in _DURATIONS if float(d * 60 / bpm) >= least]
+    if not durs:
+        return None
+    d = durs[int(rng.integers(len(durs)))]
+    if t + d > end:
+        return None
+    return [Symbol(t, d, "turn", ("right", "left")[int(rng.integers(2))], None, amount=amount)], t + d
+
+
+def _spring(rng, t, end, bpm, slow, landed, level_now, turns):
+    """One spring of a random form: preparation in plié, flight, landing in plié, recovery.
+
+    Returns None when it does not fit before `end`.  A two-foot take-off
+    needs both feet standing (no foot a step has just released).
+    """
+    form = _SPRING_FORMS[int(rng.integers(len(_SPRING_FORMS)))]
+    flights = [Fraction(n, 4) for n in range(2, 9) if FLIGHT_S[0] <= float(Fraction(n, 4) * 60 / bpm) <= FLIGHT_S[1]]
+    if not flights:
+        return None
+    fd = flights[int(rng.integers(len(flights)))]
+    land = Fraction(int(rng.integers(2, 5)), 4)
+    prep = slow[int(rng.integers(len(slow)))]
+    recover = slow[0]
+    syms = []
+    foot = ("right", "left")[int(rng.integers(2))] if landed is None else landed
+    free = _other(foot)
+    if form in ("jump", "sissonne"):
+        if level_now != "low":
+            syms.append(Symbol(t, prep, "support", "place", "low"))
+            t += prep
+    else:
+        syms.append(Symbol(t, prep, f"{foot}_support", "place", "low"))
+        syms.append(Symbol(t, prep, f"{free}_leg", *_pick(rng, _free_leg_targets(free))))
+        t += prep
+    ta, tb = t, t + fd
+    te = tb + land
+    if te + recover > end:
+        return None
+    syms.append(Symbol(ta, fd, "support", "air", None))
+    if turns and int(rng.integers(2)):
+        k = AIR_TURN_EIGHTHS[int(rng.integers(len(AIR_TURN_EIGHTHS)))]
+        syms.append(Symbol(ta, fd, "turn", ("right", "left")[int(rng.integers(2))], None, amount=Fraction(k, 8)))
+    two = ("place", "forward", "back", "right", "left")
+    if form in ("jump", "assemblé"):
+        syms.append(Symbol(tb, land, "support", two[int(rng.integers(len(two)))], "low"))
+        syms.append(Symbol(te, recover, "support", "place", "middle"))
+        return syms, te + recover, None
+    lander = {"hop": foot, "leap": free, "sissonne": foot}[form]
+    other = _other(lander)
+    one = ("place", "forward", "back", lander)
+    syms.append(Symbol(tb, land, f"{lander}_support", one[int(rng.integers(len(one)))], "low"))
+    if form != "hop":
+        # The leg that does not land extends in the air and holds until the closing.
+        syms.append(Symbol(ta, fd + land, f"{other}_leg", *_pick(rng, _free_leg_targets(other))))
+    syms.append(Symbol(te, recover, "support", "place", "middle"))
+    return syms, te + recover, other
+
+
+def _walk(rng, t, end, landed):
+    """Travel: a few steps of alternating feet, forward, back, sideways or diagonally."""
+    foot = ("right", "left")[int(rng.integers(2))] if landed is None else _other(landed)
+    syms = []
+    for _ in range(int(rng.integers(WALK_STEPS[0], WALK_STEPS[1] + 1))):
+        d = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
+        if t + d > end:
+            break
+        ways = ("forward", "back", foot, f"{foot}_forward", f"{foot}_back")
+        syms.append(Symbol(t, d, f"{foot}_support", ways[int(rng.integers(len(ways)))], "middle"))
+        t += d
+        landed, foot = foot, _other(foot)
+    return (syms, t, landed) if syms else None
+
+
+def _legs_track(rng, n_beats, bpm, turns=False, springs=False, travel=False):
     """Supports and leg gestures: weight transfers, free-leg gestures, steps.
 
     A change of support level lasts at least :data:`LEVEL_CHANGE_S` seconds
@@ -266,7 +385,29 @@ def _legs_track(rng, n_beats, bpm):
     slow = [d for d in _DURATIONS if d * 60 / bpm >= LEVEL_CHANGE_S] or [max(_DURATIONS)]
     landed = None  # a foot that has just landed: it keeps the weight next
     released = None  # the foot a step left off the floor
+    level_now = "middle"  # support level on both feet
+    extras = [k for k, on in (("pirouette", turns), ("swivel", turns), ("spring", springs), ("walk", travel)) if on]
     while True:
+        if extras and rng.random() < 0.5:
+            kind = extras[int(rng.integers(len(extras)))]
+            if kind == "pirouette":
+                got = _pirouette(rng, t, end, slow, landed)
+            elif kind == "swivel":
+                got = _swivel(rng, t, end, bpm) if released is None else None
+                got = None if got is None else (*got, None)
+            elif kind == "spring":
+                got = None if released is not None else _spring(rng, t, end, bpm, slow, landed, level_now, turns)
+            else:
+                got = _walk(rng, t, end, landed)
+            if got is None:
+                if t + max(_DURATIONS) > end:
+                    return out
+                continue
+            syms, t, landed = got
+            out += syms
+            released = _other(landed) if kind == "walk" else None
+            level_now = "middle" if kind != "swivel" else level_now
+            continue
         kind = ("both", "single", "step")[int(rng.choice(3, p=(0.35, 0.45, 0.2)))]
         dur = _DURATIONS[int(rng.integers(len(_DURATIONS)))]
         if kind in ("both", "single"):
@@ -274,7 +415,8 @@ def _legs_track(rng, n_beats, bpm):
         if kind == "both":
             if t + dur > end:
                 return out
-            out.append(Symbol(t, dur, "support", "place", ("low", "middle", "high")[int(rng.integers(3))]))
+            level_now = ("low", "middle", "high")[int(rng.integers(3))]
+            out.append(Symbol(t, dur, "support", "place", level_now))
             t += dur
         elif kind == "step":
             # After a step the other foot steps (a walk): the foot just
@@ -285,6 +427,7 @@ def _legs_track(rng, n_beats, bpm):
                 return out
             out.append(Symbol(t, dur, f"{foot}_support", d, "middle"))
             t += dur
+            level_now = "middle"
             landed, released = foot, _other(foot)
             continue
         else:
@@ -312,6 +455,7 @@ def _legs_track(rng, n_beats, bpm):
             out += gestures
             out.append(Symbol(g_t, close, "support", "place", "middle"))
             t = g_t + close
+            level_now = "middle"
             landed, released = free, None  # the free foot has just closed
             continue
         # On both feet: a foot a step released has just closed.
@@ -327,6 +471,11 @@ def random_score(
     random_effort: bool = False,
     max_tries: int = 50,
     fps: float = VERIFY_FPS,
+    *,
+    turns: bool = False,
+    springs: bool = False,
+    travel: bool = False,
+    axes: str = "standard",
 ) -> Score:
     """Draw a random valid, renderable score (see the module docstring).
 
@@ -351,6 +500,24 @@ def random_score(
         Frame rate at which the draw is verified: the one it will be
         performed at (a foot's speed near DESIGN.md's 0.2 m/s support
         threshold depends on the frame rate through finite differences).
+    turns : bool
+        With ``"legs"``: pirouettes on one foot rising into relevé, the free
+        leg lifted (1/8 … 2 turns, either way), slow turns on both feet (an
+        eighth or a quarter, under :data:`SWIVEL_RAD_S`), and with `springs`
+        turns in the air (a quarter, half or whole turn).
+    springs : bool
+        With ``"legs"``: springs of the five forms (jump, hop, leap,
+        assemblé, sissonne), from a plié into flight of
+        :data:`FLIGHT_S` seconds, landing in plié (in place or a step's
+        length away), then rising or closing.
+    travel : bool
+        With ``"legs"``: walks of :data:`WALK_STEPS` steps of alternating
+        feet, forward, back, sideways or diagonally (relative to the front).
+    axes : {"standard", "body"}
+        The score's key (arms and head read in the body cross for ``"body"``).
+
+    With none of `turns`, `springs`, `travel` and the standard key, the draw
+    is the same as before they existed (same generator stream).
 
     Returns
     -------
@@ -372,9 +539,15 @@ def random_score(
     if not set(parts) <= known:
         raise SyntheticError(f"unknown parts {sorted(set(parts) - known)}; expected some of {sorted(known)}")
     # Supports are timed for the fastest tempo that may be drawn (the tempo
-    # is drawn after the symbols, keeping the arms' and head's draws).
+    # is drawn after the symbols, keeping the arms' and head's draws); turns
+    # and springs are timed in seconds, so with them the tempo comes first.
+    extended = turns or springs or travel
     legs_bpm = Fraction(120) if tempo is None else Fraction(tempo)
     for _ in range(int(max_tries)):
+        early_bpm = None
+        if extended and tempo is None:
+            early_bpm = Fraction(int(rng.integers(60, 121)))
+            legs_bpm = early_bpm
         syms: list = []
         chest: list = []
         if "chest" in parts:
@@ -385,12 +558,15 @@ def random_score(
             elif p == "head":
                 syms += _head_track(rng, chest, n_beats)
             elif p == "legs":
-                syms += _legs_track(rng, n_beats, legs_bpm)
+                syms += _legs_track(rng, n_beats, legs_bpm, turns=turns, springs=springs, travel=travel)
             elif p in ("right_arm", "left_arm") and split_arms:
                 syms += _split_arm_track(rng, p.split("_")[0], 0, n_beats, chest)
             elif p in ("right_arm", "left_arm"):
                 syms += _gesture_track(rng, p, ARM_TARGETS, 0, n_beats, chest=chest)
-        bpm = Fraction(int(rng.integers(60, 121))) if tempo is None else Fraction(tempo)
+        if early_bpm is not None:
+            bpm = early_bpm
+        else:
+            bpm = Fraction(int(rng.integers(60, 121))) if tempo is None else Fraction(tempo)
         effort = None
         if random_effort:
             effort = Effort(
@@ -400,7 +576,7 @@ def random_score(
             )
         if not syms:
             continue
-        score = Score(tuple(syms), title="random", tempo=bpm, meter=4, effort=effort)
+        score = Score(tuple(syms), title="random", tempo=bpm, meter=4, effort=effort, axes=axes)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", UnreachableWarning)
             interpret(score, fps=fps)

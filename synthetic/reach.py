@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from capture2notation.body import JOINTS, body_frame, forward_kinematics, joint_index, segment_vectors
+from capture2notation.body import JOINTS, body_frame, forward_kinematics, joint_index, key_frame, segment_vectors
 from capture2notation.notation.directions import bend_angle, bend_degree, classify_indices
 from capture2notation.notation.model import DIRECTIONS, LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Symbol
 
@@ -86,7 +86,10 @@ class Unreached:
         """One line naming the symbol (start, part, direction, level) and the limit."""
         s = self.symbol
         what_sym = (
-            f"{s.part} {s.direction} {s.level} bend={s.bend} at beat {s.start}"
+            f"{s.part} {s.direction}"
+            + (f" {s.level} bend={s.bend}" if s.level is not None else "")
+            + (f" amount={s.amount}" if s.amount is not None else "")
+            + f" at beat {s.start}"
             if s is not None
             else f"{self.part} {_START[self.part]} (the start pose)"
         )
@@ -100,10 +103,19 @@ class Unreached:
 _START = {"head": "place high", "chest": "place high", "right_arm": "place low", "left_arm": "place low"}
 
 
-def _readings(J: np.ndarray, part: str):
+#: Parts read in the body cross of axes when a score is keyed to it.
+BODY_KEY_PARTS = frozenset(
+    {"head", "right_arm", "left_arm", "right_upper_arm", "right_forearm", "left_upper_arm", "left_forearm"}
+)
+#: Largest miss of a turn's written front at its end frame, degrees.
+FRONT_TOL_DEG = 1.0
+
+
+def _readings(J: np.ndarray, part: str, axes: str = "standard"):
     """(T,) direction index, level index and bend degree of a gesture part."""
     a, b = PART_SEGMENTS[part]
-    d, lv = classify_indices(segment_vectors(J, a, b, body_frame(J)))
+    frame = key_frame(J, axes) if part in BODY_KEY_PARTS else body_frame(J)
+    d, lv = classify_indices(segment_vectors(J, a, b, frame))
     bend = np.zeros(len(J), int)
     if part in PART_MIDDLE_JOINT:
         m = joint_index(PART_MIDDLE_JOINT[part])
@@ -173,7 +185,7 @@ def _limit_hit(raw, clipped, limits, joints, frames) -> str:
     return text
 
 
-def reach_report(motion: Motion, raw_angles: np.ndarray | None = None) -> list:
+def reach_report(motion: Motion, raw_angles: np.ndarray | None = None, axes: str = "standard") -> list:
     """Everything the motion does not perform as its score says.
 
     Parameters
@@ -183,6 +195,8 @@ def reach_report(motion: Motion, raw_angles: np.ndarray | None = None) -> list:
     raw_angles : (T, J, 3) ndarray, optional
         The angles asked for before the extremes were enforced; without them
         ``"path"`` problems are not found and no limit is named.
+    axes : {"standard", "body"}
+        The score's key: arms and head are read in the body cross for ``"body"``.
 
     Returns
     -------
@@ -195,7 +209,27 @@ def reach_report(motion: Motion, raw_angles: np.ndarray | None = None) -> list:
     limits, clipped = motion.body.limits, motion.angles
     out = []
     readings, feet = {}, {}
+    front = None
+    written = 0.0
     for sym, f0, f1 in motion.events:
+        if sym.is_turn:
+            # The front at the turn's end must be every turn written so far.
+            front = motion.front if front is None else front
+            written += float(sym.signed_amount) * 360.0
+            got = front[min(f1, len(front) - 1)]
+            if not abs(got - written) <= FRONT_TOL_DEG:
+                out.append(Unreached(sym, sym.part, "end", f1, ("front", f"{got:.1f}°"), ""))
+            continue
+        if sym.is_air:
+            # No foot may read as supporting strictly inside a flight.
+            for foot in ("right", "left"):
+                if foot not in feet:
+                    feet[foot] = _support_reading(J, motion.fps, foot, motion.body)
+            grounded = [f for f in ("right", "left") if feet[f][0][f0 + 1 : f1].any()]
+            if grounded:
+                f = f0 + 1 + int(np.argmax(feet[grounded[0]][0][f0 + 1 : f1]))
+                out.append(Unreached(sym, sym.part, "path", f, (f"{grounded[0]}_foot", "on the floor", 0), ""))
+            continue
         joints = PART_JOINTS[sym.part]
         if raw_angles is not None and f1 > f0 + 1:
             # On the way, the extremes may hold a joint back no more than at
@@ -236,7 +270,7 @@ def reach_report(motion: Motion, raw_angles: np.ndarray | None = None) -> list:
                     break
             continue
         if sym.part not in readings:
-            readings[sym.part] = _readings(J, sym.part)
+            readings[sym.part] = _readings(J, sym.part, axes)
         d, lv, bend = (r[f1] for r in readings[sym.part])
         if (d, lv, bend) != _code(sym):
             out.append(
@@ -244,11 +278,11 @@ def reach_report(motion: Motion, raw_angles: np.ndarray | None = None) -> list:
                     sym, sym.part, "end", f1, _name(d, lv, bend), _limit_hit(raw_angles, clipped, limits, joints, [f1])
                 )
             )
-    out += _holds(motion, J, raw_angles, readings)
+    out += _holds(motion, J, raw_angles, readings, axes)
     return out
 
 
-def _holds(motion: Motion, J, raw_angles, readings) -> list:
+def _holds(motion: Motion, J, raw_angles, readings, axes: str = "standard") -> list:
     """Holds of head, chest and whole arms that the pose does not keep."""
     T = motion.n_frames
     out = []
@@ -263,7 +297,7 @@ def _holds(motion: Motion, J, raw_angles, readings) -> list:
             moving[f0 + 1 : f1 + 1] = True  # the end frame is checked as an "end"
             held[f1:] = i
         if part not in readings:
-            readings[part] = _readings(J, part)
+            readings[part] = _readings(J, part, axes)
         d, lv, bend = readings[part]
         syms = [s for s, _, _ in own]
         for i in range(-1, len(syms)):
@@ -282,13 +316,15 @@ def _holds(motion: Motion, J, raw_angles, readings) -> list:
     return out
 
 
-def unreachable(motion: Motion) -> list:
+def unreachable(motion: Motion, axes: str = "standard") -> list:
     """Symbols whose end pose does not read back as the symbol.
 
     Parameters
     ----------
     motion : Motion
         With ``events`` (as made by :func:`~synthetic.interpret.interpret`).
+    axes : {"standard", "body"}
+        The score's key.
 
     Returns
     -------
@@ -298,4 +334,4 @@ def unreachable(motion: Motion) -> list:
         ``("none", "", 0)``); empty when every symbol was reached.  See
         :func:`reach_report` for paths, holds and the limits to blame.
     """
-    return [(u.symbol, u.got) for u in reach_report(motion) if u.kind == "end"]
+    return [(u.symbol, u.got) for u in reach_report(motion, axes=axes) if u.kind == "end"]

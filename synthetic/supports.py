@@ -29,9 +29,10 @@ from capture2notation.body import Body, euler_to_matrix, joint_index
 from capture2notation.errors import SyntheticError
 from capture2notation.notation.directions import canonical_vector
 from capture2notation.notation.effort import progress
-from capture2notation.notation.model import Effort, Score
+from capture2notation.notation.model import AIR, Effort, Score
 
 from .extremes import keep_paths_within
+from .flight import land, plan_flight
 from .limbs import Limb, apply_move, group_moves
 from .motion import euler_near
 from .rotations import rot_x, slerp_frames, unit
@@ -72,10 +73,11 @@ SUPPORT_FEET = {"support": ("right", "left"), "right_support": ("right",), "left
 
 
 def _foot_events(score: Score, foot: str):
-    """Support symbols naming `foot` and gesture symbols of its leg, in time order."""
+    """Support symbols naming `foot`, gesture symbols of its leg and flights, in time order."""
     leg = {f"{foot}_leg", f"{foot}_thigh", f"{foot}_shin"}
-    sup = [s for s in score.symbols if s.part in SUPPORT_FEET and foot in SUPPORT_FEET[s.part]]
+    sup = [s for s in score.symbols if s.part in SUPPORT_FEET and foot in SUPPORT_FEET[s.part] and not s.is_air]
     ges = [s for s in score.symbols if s.part in leg]
+    airs = [s for s in score.symbols if s.is_air]
     for a, b in itertools.pairwise(sup):
         if b.start < a.end:
             raise SyntheticError(
@@ -88,17 +90,22 @@ def _foot_events(score: Score, foot: str):
                     f"{s.part} at beat {s.start}-{s.end} overlaps the {foot} leg's gesture {g.part} "
                     f"at beat {g.start}-{g.end}: a leg cannot gesture and support at once"
                 )
-    return sup, ges
+    return sup, ges, airs
 
 
-def _planted_after(sup, ges, beat) -> bool:
+def _planted_after(sup, ges, airs, beat) -> bool:
     """Whether a foot bears weight just after `beat`.
 
     Feet start planted; a gesture of the leg frees the foot from its start, a
-    support symbol plants it at its end; at a tie the gesture wins.
+    support symbol plants it at its end; at a tie the gesture wins.  A
+    flight frees the feet after its start (at the take-off beat itself they
+    still bear the weight they push off with), and so does a gesture that
+    begins with the flight (the take-off leg of a leap).
     """
+    take_offs = {a.start for a in airs}
     effects = [(s.end, 0, True) for s in sup if s.end <= beat]
-    effects += [(g.start, 1, False) for g in ges if g.start <= beat]
+    effects += [(g.start, 1, False) for g in ges if g.start < beat or (g.start == beat and beat not in take_offs)]
+    effects += [(a.start, 1, False) for a in airs if a.start < beat]
     return max(effects)[2] if effects else True
 
 
@@ -131,9 +138,11 @@ def _weight_feet(sups, events, beat) -> list:
 
     Those named by the support symbols in force at `beat` (begun before it,
     not yet ended), less feet whose leg starts a gesture by then; with no
-    support symbol in force, every planted foot.
+    support symbol in force, every planted foot; none in flight.
     """
-    named = {f for s in sups if s.start < beat <= s.end for f in SUPPORT_FEET[s.part]}
+    if any(s.is_air and s.start < beat <= s.end for s in sups):
+        return []
+    named = {f for s in sups if s.start < beat <= s.end and not s.is_air for f in SUPPORT_FEET[s.part]}
     if not named:
         return [f for f in ("right", "left") if _planted_after(*events[f], beat)]
     return [f for f in ("right", "left") if f in named and _planted_after(*events[f], beat)]
@@ -163,7 +172,37 @@ class Support:
         self.landing = {f: np.zeros(T, bool) for f in ("right", "left")}
         # Frames on which a foot that a support released holds its leg.
         self.released = {f: np.zeros(T, bool) for f in ("right", "left")}
+        self.step = STEP_LENGTH * body.height
+        self.leg_reach = float(self.limbs["right"].reach)
+        # Touchdown frame of each flight -> pelvis velocity then (m/s).
+        self.touchdown: dict[int, np.ndarray] = {}
         self._plan(score)
+
+    def pivot(self, turn) -> np.ndarray | None:
+        """Plan-coordinate pivot track of `turn` (:mod:`synthetic.turning`), None to pivot about the pelvis.
+
+        Per frame, the mean centre (midpoint of ankle and toe) of the feet
+        bearing weight at the turn's end: a centre moves only as its foot
+        rises or lowers, so the foot spins on the spot.  None in the air or
+        with no foot bearing weight.
+
+        Returns
+        -------
+        (T, 2) ndarray or None
+        """
+        if any(a.is_air and a.start < turn.end and turn.start < a.end for a in self.sups):
+            return None
+        feet = _weight_feet(self.sups, self.events, turn.end)
+        if not feet:
+            return None
+        toe = self.body.offsets[joint_index("right_toe")]
+        centres = [self.ankle[f][:, :2] + 0.5 * (rot_x(self.pitch[f]) @ toe)[:, :2] for f in feet]
+        return np.mean(centres, axis=0)
+
+    def foot_symbols(self, foot: str) -> list:
+        """Support symbols naming `foot` and gestures of its leg."""
+        sup, ges, _ = self.events[foot]
+        return list(sup) + list(ges)
 
     def _just_landed(self, foot: str, f0: int) -> bool:
         """Whether `foot` comes down onto the floor at frame `f0` (or `f0` is the first frame).
@@ -185,15 +224,23 @@ class Support:
         xy = {f: body.rest[joint_index(f"{f}_ankle")][:2].copy() for f in ("right", "left")}
         level = dict.fromkeys(("right", "left"), "middle")
         sups = sorted((s for s in score.symbols if s.is_support), key=lambda s: (s.end, s.start))
+        self.sups = sups
+        touchdowns = {s.end for s in sups if s.is_air}
+        landings = [s for s in sups if not s.is_air and s.start in touchdowns]
         for s in sups:
-            if s.part == "support" and s.direction != "place":
+            if s.part == "support" and s.direction not in ("place", AIR) and s not in landings:
                 raise SyntheticError(
-                    f"support at beat {s.start}: a step on both feet ({s.direction}) is not supported; "
-                    "notate right_support / left_support steps instead"
+                    f"support at beat {s.start}: a step on both feet ({s.direction}) is not supported "
+                    "except as a landing; notate right_support / left_support steps instead"
                 )
         last_key = 0
         for s in sups:
             f0, f1 = frame(s.start), frame(s.end)
+            if s.is_air:
+                before = _weight_feet(sups, self.events, s.start)
+                plan_flight(self, s, [x for x in landings if x.start == s.end], before, xy, level)
+                last_key = max(last_key, f1)
+                continue
             n = np.arange(f0 + 1, f1 + 1)
             tau = (n - f0) / max(f1 - f0, 1)
             # The foot travels with the Effort progress and touches down on
@@ -203,7 +250,7 @@ class Support:
             # A foot bears weight if the supports in force name it (a step
             # onto the other foot releases it, as a gesture of its leg does).
             bearing = _weight_feet(sups, self.events, s.start)
-            for foot in SUPPORT_FEET[s.part]:
+            for foot in () if s in landings else SUPPORT_FEET[s.part]:
                 planted = foot in bearing
                 other = "left" if foot == "right" else "right"
                 if planted:
@@ -262,6 +309,10 @@ class Support:
                 L = self._leg_length(level[f])
                 zs.append(self.level_z[level[f]] + np.sqrt(max(L * L - h * h, 0.0)))
             key[2] = min(zs)
+            if s in landings:
+                land(self, s, key)
+                last_key = max(last_key, f1)
+                continue
             fa = max(f0, last_key)
             m = np.arange(fa + 1, f1 + 1)
             if f1 > fa:
@@ -273,11 +324,13 @@ class Support:
             self.root[f1:] = key
             last_key = max(last_key, f1)
         self._release(sups)
-        # Gesturing frames: from a gesture's start to the next support's start.
+        # Gesturing frames: from a gesture's start to the next support's start,
+        # or to the take-off of a flight the foot lands from (its landing blend).
         for foot in ("right", "left"):
-            sup, ges = self.events[foot]
+            sup, ges, airs = self.events[foot]
+            lands_from = [a for a in airs if any(x.start == a.end for x in sup)]
             for g in ges:
-                nxt = min((x.start for x in sup if x.start >= g.end), default=None)
+                nxt = min((x.start for x in sup + lands_from if x.start >= g.end), default=None)
                 stop = T if nxt is None else frame(nxt) + 1
                 self.floor[foot][frame(g.start) + 1 : stop] = False
 
@@ -292,13 +345,15 @@ class Support:
         that reads as an unwritten gesture).
         """
         for s in sups:
+            if s.is_air:
+                continue  # the flight releases the feet that do not land (synthetic.flight)
             before = _weight_feet(sups, self.events, s.start)
             after = _weight_feet(sups, self.events, s.end)
             f1 = self.frame(s.end)
             for foot in ("right", "left"):
                 if foot in SUPPORT_FEET[s.part] or foot not in before or foot in after:
                     continue
-                sup, ges = self.events[foot]
+                sup, ges, _ = self.events[foot]
                 nxt = min([x.start for x in sup + ges if x.start >= s.end], default=None)
                 stop = self.T - 1 if nxt is None else self.frame(nxt)
                 self.released[foot][f1 + 1 : stop + 1] = True

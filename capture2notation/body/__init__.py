@@ -1,6 +1,6 @@
 """Body model: the joint tree, proportions, extremes and forward kinematics."""
 
-from .frames import body_frame, segment_vectors
+from .frames import body_cross, body_frame, front_of, key_frame, rotation_front, segment_vectors
 from .kinematics import euler_to_matrix, forward_kinematics, global_rotations, matrix_to_euler
 from .landmarks import landmarks_from_joints, landmarks_from_pose  # noqa: F401
 from .skeleton import (
@@ -22,11 +22,15 @@ __all__ = [
     "JOINT_TO_BLAZEPOSE",
     "PARENT",
     "Body",
+    "body_cross",
     "body_frame",
     "euler_to_matrix",
     "forward_kinematics",
+    "front_of",
     "global_rotations",
     "joint_index",
+    "key_frame",
     "matrix_to_euler",
+    "rotation_front",
     "segment_vectors",
 ]

@@ -1,4 +1,5 @@
-"""The body frame of DESIGN.md and limb-segment vectors expressed in it."""
+"""The body frames of DESIGN.md (the standard and the body cross of axes), the front,
+and limb-segment vectors expressed in a frame."""
 
 from __future__ import annotations
 
@@ -7,7 +8,10 @@ import numpy as np
 from ..errors import BodyModelError
 from .skeleton import JOINTS, joint_index
 
-__all__ = ["body_frame", "segment_vectors"]
+__all__ = ["body_cross", "body_frame", "front_of", "key_frame", "rotation_front", "segment_vectors"]
+
+#: The crosses of axes (DESIGN.md, "Cross of axes").
+AXES = ("standard", "body")
 
 
 def body_frame(joints: np.ndarray) -> np.ndarray:
@@ -37,6 +41,81 @@ def body_frame(joints: np.ndarray) -> np.ndarray:
     up = np.broadcast_to(np.array([0.0, 0.0, 1.0]), right.shape)
     forward = np.cross(up, right)
     return np.stack([right, forward, up], axis=1)
+
+
+def body_cross(joints: np.ndarray) -> np.ndarray:
+    """The body cross of axes at each instant (LabanotationSuite's Kinect frame).
+
+    ``forward`` is the normal of the plane through both shoulders and the
+    mid-spine (our ``waist``, Kinect's SpineMid), pointing to the body's
+    front: ``(waist − right shoulder) × (left shoulder − right shoulder)``;
+    ``left`` is the shoulder line (right → left shoulder); ``up = forward ×
+    left`` runs along the torso.  As in the suite's
+    ``labanProcessor.calculate_base_rotation``.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joint positions, metres.
+
+    Returns
+    -------
+    (T, 3, 3) ndarray
+        Rows ``right`` (= −left), ``forward``, ``up``; NaN where the three
+        points are missing or collinear.
+    """
+    joints = _check(joints)
+    r = joints[:, joint_index("right_shoulder")]
+    v1 = joints[:, joint_index("left_shoulder")] - r
+    v2 = joints[:, joint_index("waist")] - r
+    forward = np.cross(v2, v1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        nf = np.linalg.norm(forward, axis=-1, keepdims=True)
+        nl = np.linalg.norm(v1, axis=-1, keepdims=True)
+        forward = np.where(nf > 1e-12, forward / nf, np.nan)
+        left = np.where(nl > 1e-12, v1 / nl, np.nan)
+    up = np.cross(forward, left)
+    return np.stack([-left, forward, up], axis=1)
+
+
+def key_frame(joints: np.ndarray, axes: str = "standard") -> np.ndarray:
+    """:func:`body_frame` (``axes="standard"``) or :func:`body_cross` (``"body"``)."""
+    if axes == "standard":
+        return body_frame(joints)
+    if axes == "body":
+        return body_cross(joints)
+    raise BodyModelError(f"unknown axes {axes!r}; expected one of {' '.join(AXES)}")
+
+
+def front_of(forward: np.ndarray) -> np.ndarray:
+    """Unwrapped front, degrees clockwise seen from above from the room's +y.
+
+    Parameters
+    ----------
+    forward : (T, 3) ndarray
+        A forward direction per frame (e.g. the pelvis's +y, or the body
+        frame's ``forward``); its horizontal part is used.
+
+    Returns
+    -------
+    (T,) ndarray
+        ``atan2(x, y)`` in degrees, unwrapped through full turns (two right
+        pirouettes end at +720, not 0); NaN where `forward` is missing or
+        vertical (the unwrapping bridges such frames).
+    """
+    forward = np.asarray(forward, dtype=float)
+    a = np.arctan2(forward[:, 0], forward[:, 1])
+    bad = ~np.isfinite(a) | (np.hypot(forward[:, 0], forward[:, 1]) < 1e-9)
+    out = np.full(a.shape, np.nan)
+    ok = ~bad
+    if ok.any():
+        out[ok] = np.degrees(np.unwrap(a[ok]))
+    return out
+
+
+def rotation_front(rotations: np.ndarray) -> np.ndarray:
+    """(T,) unwrapped front (:func:`front_of`) of the pelvis's global rotations (T, 3, 3)."""
+    return front_of(np.asarray(rotations, dtype=float)[:, :, 1])
 
 
 def segment_vectors(joints: np.ndarray, a: str, b: str, frame: np.ndarray | None = None) -> np.ndarray:

@@ -9,7 +9,11 @@ feet at the same level in place, and overlapping per-foot supports
 (Wolofsky's 1974 style, ``0 4 right_support`` with ``0 1 left_support``)
 become the transition they describe (``0 1 right_support``).  The support parts (``support``,
 ``right_support``, ``left_support``) form one column, ``supports``, whose
-state is (part, direction, level).
+state is (part, direction, level) — for flight (part, ``"air"``, spring
+form), so a hop written as a leap disagrees.  Turns form the ``front``
+column, whose state is the front a turn takes the dancer to (full turns
+clockwise from the start, unwrapped): a half turn right and a half turn
+left end facing the same way but not at the same front.
 
 Comparison happens in *time*: a captured score may be written at another
 tempo (an estimated tempo can be twice the written one, with every duration
@@ -31,14 +35,16 @@ fractions), and every figure below is in reference beats.
 
 from __future__ import annotations
 
+import bisect
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 
 import numpy as np
 
 from ..errors import CompareError
 from ..notation.directions import canonical_vector, classify
+from ..notation.facing import springs
 from ..notation.model import GESTURE_PARTS, Score, Symbol
 
 __all__ = [
@@ -94,17 +100,30 @@ def _support_transitions(symbols) -> list:
     other foot over the ended symbol's span."""
     syms = list(symbols)
     feet = [s for s in syms if s.part in ("right_support", "left_support")]
-    out = [s for s in syms if s not in feet]
+    foot_ids = {id(s) for s in feet}
+    out = [s for s in syms if id(s) not in foot_ids]
+    # One foot's symbols never overlap, so the other foot's symbol that could
+    # contain s is the last one starting at or before s (found by bisection).
+    by_part = {
+        p: sorted((t for t in feet if t.part == p), key=lambda t: t.start) for p in ("right_support", "left_support")
+    }
+    starts = {p: [t.start for t in ts] for p, ts in by_part.items()}
     used = set()
     for s in feet:
-        for t in feet:
-            if t.part != s.part and t.start <= s.start and s.end < t.end and id(s) not in used:
-                # s ends first while t still supports: weight onto t's foot.
-                used.add(id(s))
-                if t.start < s.start:
-                    continue
-                used.add(id(t))
-                out.append(Symbol(s.start, s.duration, t.part, t.direction, t.level, 0))
+        if id(s) in used:
+            continue
+        other = "left_support" if s.part == "right_support" else "right_support"
+        k = bisect.bisect_right(starts[other], s.start)
+        if k == 0:
+            continue
+        t = by_part[other][k - 1]
+        if s.end < t.end:
+            # s ends first while t still supports: weight onto t's foot.
+            used.add(id(s))
+            if t.start < s.start:
+                continue
+            used.add(id(t))
+            out.append(Symbol(s.start, s.duration, t.part, t.direction, t.level, 0))
     out += [s for s in feet if id(s) not in used]
     return out
 
@@ -115,6 +134,9 @@ def normalise(score: Score) -> Score:
     out: list[Symbol] = []
     support = DEFAULT_SUPPORT
     for s in sorted(_support_transitions(_join_straight_limbs(score.symbols)), key=Symbol.sort_key):
+        if s.is_turn:
+            out.append(s)
+            continue
         if s.is_support:
             key = (s.part, s.direction, s.level)
             if s.direction == "place" and key == support:
@@ -134,7 +156,7 @@ def normalise(score: Score) -> Score:
             elif s.part in (up, low):
                 state[limb] = None
         out.append(s)
-    return Score(symbols=tuple(out), title=score.title, tempo=score.tempo, meter=score.meter)
+    return Score(symbols=tuple(out), title=score.title, tempo=score.tempo, meter=score.meter, axes=score.axes)
 
 
 def at_tempo(score: Score, tempo) -> Score:
@@ -158,7 +180,7 @@ def at_tempo(score: Score, tempo) -> Score:
     k = tempo / score.tempo
     if k == 1:
         return score
-    syms = tuple(Symbol(s.start * k, s.duration * k, s.part, s.direction, s.level, s.bend) for s in score.symbols)
+    syms = tuple(replace(s, start=s.start * k, duration=s.duration * k) for s in score.symbols)
     return score.replace(symbols=syms, tempo=tempo)
 
 
@@ -176,19 +198,36 @@ def state_at(score: Score, part: str, beats) -> list[tuple]:
     score : Score
         Normalised score.
     part : str
-        A gesture part, or ``"supports"`` for the support column.
+        A gesture part, ``"supports"`` for the support column or
+        ``"front"`` for the turns.
     beats : sequence of Fraction
         Sorted sample beats.
 
     Returns
     -------
     list of tuple
-        (direction, level) — (part, direction, level) for ``supports`` — of
-        the last symbol that has started at each beat, else the default.
+        (direction, level) — (part, direction, level) for ``supports``, with
+        the spring form as the level of flight; ``(front,)`` in full turns
+        as text (``"1/2"``) for ``front`` — of the last symbol that has
+        started at each beat, else the default.
     """
     cur: tuple
+    if part == "front":
+        turns = [s for s in score.symbols if s.is_turn]
+        fronts, total = [], Fraction(0)
+        for t in turns:
+            total += t.signed_amount
+            fronts.append(total)
+        out, i = [], 0
+        for b in beats:
+            while i < len(turns) and turns[i].start <= b:
+                i += 1
+            out.append((str(fronts[i - 1] if i else Fraction(0)),))
+        return out
+    forms = {}
     if part == "supports":
         syms = [s for s in score.symbols if s.is_support]
+        forms = {id(a): form for a, form in springs(score)}
         cur = DEFAULT_SUPPORT
     else:
         family = _FAMILY.get(part, (part,))
@@ -201,7 +240,7 @@ def state_at(score: Score, part: str, beats) -> list[tuple]:
             s = syms[i]
             i += 1
             if part == "supports":
-                cur = (s.part, s.direction, s.level)
+                cur = (s.part, s.direction, (forms[id(s)] or "unlanded") if s.is_air else s.level)
             elif s.part == family[0]:
                 cur = (s.direction, s.level)
                 segs = dict.fromkeys(segs, cur)
@@ -262,6 +301,8 @@ def _parts(ref: Score, cand: Score) -> list[str]:
     parts = [p for p in DEFAULT_STATE if p in columns]
     if any(s.is_support for s in ref.symbols + cand.symbols):
         parts.append("supports")
+    if any(s.is_turn for s in ref.symbols + cand.symbols):
+        parts.append("front")
     return parts
 
 
@@ -272,7 +313,7 @@ class Cell:
     Attributes
     ----------
     part : str
-        Column: a gesture part or ``"supports"``.
+        Column: a gesture part, ``"supports"`` or ``"front"``.
     beat : Fraction
         Sample time (the cell's centre), reference beats.
     ref, cand : tuple
@@ -343,7 +384,7 @@ def symbol_agreement(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> f
 
 
 def start_errors(ref: Score, cand: Score) -> tuple[np.ndarray, int]:
-    """Start-time errors of reference gesture symbols, reference beats.
+    """Start-time errors of reference gesture and turn symbols, reference beats.
 
     Returns
     -------
@@ -355,15 +396,21 @@ def start_errors(ref: Score, cand: Score) -> tuple[np.ndarray, int]:
         Reference gesture symbols with no such captured symbol.
     """
     ref, cand = normalise(ref), normalise(at_tempo(cand, ref.tempo))
+    index: dict[tuple, list] = {}
+    for c in cand.symbols:
+        index.setdefault(_what(c), []).append(c.start)
+    for starts in index.values():
+        starts.sort()
     errs, missing = [], 0
     for s in ref.symbols:
         if s.is_support:
             continue
-        starts = [c.start for c in cand.symbols if (c.part, c.direction, c.level) == (s.part, s.direction, s.level)]
+        starts = index.get(_what(s), [])
         if not starts:
             missing += 1
             continue
-        errs.append(float(min(abs(c - s.start) for c in starts)))
+        k = bisect.bisect_left(starts, s.start)
+        errs.append(float(min(abs(starts[j] - s.start) for j in (k - 1, k) if 0 <= j < len(starts))))
     return np.asarray(errs, dtype=float), missing
 
 
@@ -423,8 +470,13 @@ def compare_scores(ref: Score, cand: Score, step: Fraction = Fraction(1)) -> Agr
     )
 
 
+def _what(s: Symbol) -> tuple:
+    """What a symbol writes, without its time: (part, direction, level, amount)."""
+    return (s.part, s.direction, s.level, s.amount)
+
+
 def _key(s: Symbol) -> tuple:
-    return (s.start, s.duration, s.part, s.direction, s.level, s.bend)
+    return (s.start, s.duration, s.part, s.direction, s.level, s.bend, s.amount)
 
 
 def score_differences(ref: Score, cand: Score, supports: bool = True) -> list[str]:
@@ -449,7 +501,11 @@ def score_differences(ref: Score, cand: Score, supports: bool = True) -> list[st
     b = {_key(s) for s in normalise(at_tempo(cand, ref.tempo)).symbols if supports or not s.is_support}
 
     def fmt(k):
-        start, dur, part, d, lv, bend = k
-        return f"{start} {dur} {part} {d} {lv}" + (f" bend={bend}" if bend else "")
+        start, dur, part, d, lv, bend, amount = k
+        return (
+            f"{start} {dur} {part} {d} {lv or ''}".rstrip()
+            + (f" bend={bend}" if bend else "")
+            + (f" amount={amount}" if amount is not None else "")
+        )
 
     return [f"missing: {fmt(k)}" for k in sorted(a - b, key=str)] + [f"extra: {fmt(k)}" for k in sorted(b - a, key=str)]

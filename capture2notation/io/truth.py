@@ -23,6 +23,10 @@ effort          ()           JSON text of the Effort
 view            ()           viewpoint name
 style           ()           rendering style
 body_height     ()           metres
+front           (T,)         optional: the unwrapped front, degrees clockwise
+                             seen from above from the room's +y (a right half
+                             turn ends at +180, two right pirouettes at +720);
+                             absent in sidecars written before turns
 ==============  ===========  ==================================================
 
 Stored with ``numpy.savez`` without pickles (strings as unicode arrays).
@@ -41,7 +45,7 @@ from ..atomic import atomic_path
 from ..errors import MotionFileError
 from .limits import MAX_FPS, MAX_FRAMES, MAX_IMAGE_SIDE, MAX_JOINTS, MAX_TRUTH_TEXT, MIN_FPS
 
-__all__ = ["TRUTH_FIELDS", "Truth", "read_truth", "write_truth"]
+__all__ = ["OPTIONAL_FIELDS", "TRUTH_FIELDS", "Truth", "read_truth", "write_truth"]
 
 # name -> shape pattern: ints are fixed sizes, "T"/"J" are shared free sizes,
 # None marks a text scalar.
@@ -65,6 +69,8 @@ TRUTH_FIELDS: dict[str, tuple | None] = {
     "style": None,
     "body_height": (),
 }
+#: Fields a sidecar may lack (older sidecars); None in :class:`Truth` then.
+OPTIONAL_FIELDS: dict[str, tuple] = {"front": ("T",)}
 _TEXT = {"joint_names"} | {k for k, v in TRUTH_FIELDS.items() if v is None}
 #: Largest size each free dimension may have.
 _FREE_LIMITS = {"T": MAX_FRAMES, "J": MAX_JOINTS}
@@ -97,6 +103,7 @@ class Truth:
     view: str
     style: str
     body_height: float
+    front: np.ndarray | None = None
 
     @property
     def n_frames(self) -> int:
@@ -106,7 +113,7 @@ class Truth:
 def _validate(arrays: dict, where: str) -> dict:
     """Check names, dtypes and shapes; return normalised arrays."""
     missing = [k for k in TRUTH_FIELDS if k not in arrays]
-    extra = [k for k in arrays if k not in TRUTH_FIELDS]
+    extra = [k for k in arrays if k not in TRUTH_FIELDS and k not in OPTIONAL_FIELDS]
     if missing:
         raise MotionFileError(f"{where}: truth sidecar lacks field(s) {', '.join(missing)}")
     if extra:
@@ -165,6 +172,15 @@ def _validate(arrays: dict, where: str) -> dict:
         raise MotionFileError(
             f"{where}: field image_size is {size.tolist()}; expected (width, height), whole pixels 1-{MAX_IMAGE_SIDE}"
         )
+    for name, pattern in OPTIONAL_FIELDS.items():
+        if name in arrays:
+            try:
+                arr = np.asarray(arrays[name], dtype=float)
+            except (TypeError, ValueError):
+                raise MotionFileError(f"{where}: field {name} must be numeric") from None
+            if arr.shape != (sizes.get("T", -1),):
+                raise MotionFileError(f"{where}: field {name} has shape {arr.shape}, expected {_fmt(pattern)}")
+            out[name] = arr
     vis = out["visibility"]
     if np.any((vis < 0) | (vis > 1) | np.isnan(vis)):
         raise MotionFileError(f"{where}: field visibility must lie in [0, 1]")
@@ -248,7 +264,8 @@ def write_truth(path, **fields_) -> Path:
     path : str or Path
         Destination, normally ``OUTDIR/truth.npz``.
     **fields_
-        Every field of :data:`TRUTH_FIELDS`, no others (text fields as str).
+        Every field of :data:`TRUTH_FIELDS`, optionally those of
+        :data:`OPTIONAL_FIELDS`, no others (text fields as str).
 
     Returns
     -------
@@ -279,6 +296,8 @@ def read_truth(path) -> Truth:
     a = _validate(arrays, str(path))
     kw = {}
     for f in fields(Truth):
+        if f.name in OPTIONAL_FIELDS and f.name not in a:
+            continue
         v = a[f.name]
         if f.name in ("fps", "body_height"):
             v = float(v)

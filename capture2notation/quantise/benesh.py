@@ -25,7 +25,7 @@ from fractions import Fraction
 import numpy as np
 
 from ..atomic import write_text
-from ..body import Body, body_frame, global_rotations, joint_index
+from ..body import Body, body_frame, front_of, global_rotations, joint_index
 from ..errors import QuantiseError
 from ..notation.directions import bend_angle, bend_degree
 
@@ -111,6 +111,10 @@ class BeneshPose:
     bends : tuple of (str, int)
         Elbows / knees whose bend degree differs from the default.
     head, body : Orientation
+    facing : float
+        The front at the pose: degrees clockwise seen from above from the
+        room's +y, unwrapped through the whole motion (DESIGN.md, "Facing
+        and turns"); NaN when the hips are not seen.
     """
 
     frame: int
@@ -120,6 +124,7 @@ class BeneshPose:
     bends: tuple
     head: Orientation
     body: Orientation = field(default_factory=lambda: Orientation(np.nan, np.nan, np.nan))
+    facing: float = float("nan")
 
 
 def _median_length(joints: np.ndarray, a: str, b: str) -> float:
@@ -237,6 +242,8 @@ def benesh_key_poses(
     lines = np.asarray(stave.lines)
     J = joints[frames]
     frame = body_frame(J)  # (K, 3, 3) rows right, forward, up
+    # The front over the whole motion, so it unwraps through every turn.
+    facing = front_of(body_frame(joints)[:, 1])[frames] if frames else np.zeros(0)
     mid_hip = 0.5 * (J[:, joint_index("right_hip")] + J[:, joint_index("left_hip")])
     mid_sh = 0.5 * (J[:, joint_index("right_shoulder")] + J[:, joint_index("left_shoulder")])
     head_turn = np.full(len(frames), np.nan)
@@ -288,6 +295,7 @@ def benesh_key_poses(
                 bends=tuple(bends),
                 head=_orientation(head_v, head_turn[i]),
                 body=_orientation(chest_v, _signed_turn(hp[:2], sh[:2])),
+                facing=float(facing[i]),
             )
         )
     return stave, poses
@@ -311,6 +319,7 @@ def benesh_json(stave: Stave, poses: list[BeneshPose], tempo=None) -> str:
             "units": "metres above the floor; height = line + fraction, width = fraction of reach (+ right)",
         },
         "tempo": None if tempo is None else str(Fraction(tempo)),
+        "facing_units": "degrees clockwise seen from above from the room's +y, unwrapped through turns",
         "poses": [
             {
                 "frame": p.frame,
@@ -320,6 +329,7 @@ def benesh_json(stave: Stave, poses: list[BeneshPose], tempo=None) -> str:
                 "bends": dict(p.bends),
                 "head": {k: _num(v) for k, v in asdict(p.head).items()},
                 "body": {k: _num(v) for k, v in asdict(p.body).items()},
+                "facing": _num(p.facing),
             }
             for p in poses
         ],

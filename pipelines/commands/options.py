@@ -15,6 +15,7 @@ from pathlib import Path
 import click
 
 from capture2notation.errors import PipelineError
+from capture2notation.notation.limits import MAX_TEMPO, MIN_TEMPO
 
 __all__ = [
     "FPS",
@@ -64,9 +65,8 @@ class Number(click.ParamType):
         return v
 
 
-#: Beats per minute a dance can be counted at: below 10 there is no beat to
-#: count, above 400 is faster than any dance music (speedcore runs near 300).
-TEMPO = Number(10, 400, "beats per minute")
+#: Beats per minute a score can have (:mod:`capture2notation.notation.limits`).
+TEMPO = Number(float(MIN_TEMPO), float(MAX_TEMPO), "beats per minute")
 
 
 class TempoOrNone(click.ParamType):

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from capture2notation.body import JOINTS, Body
+from capture2notation.body import JOINTS, Body, joint_index, rotation_front
 from capture2notation.errors import SyntheticError
 from capture2notation.io.truth import write_truth
 
@@ -74,6 +74,7 @@ def truth_fields(
         "view": view,
         "style": style,
         "body_height": pose.body.height,
+        "front": rotation_front(pose.rotations[:, joint_index("pelvis")]),
     }
 
 

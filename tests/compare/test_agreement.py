@@ -223,3 +223,31 @@ def test_agreement_samples_reference_beats():
     assert a.median_start_error == pytest.approx(0.25)  # median of 0.5 and 0 reference beats
     with pytest.raises(CompareError, match="tempo"):
         at_tempo(ref, 0)
+
+
+def test_front_and_spring_forms_are_compared():
+    from capture2notation.compare.agreement import agreement_cells
+    from capture2notation.notation.formats import lab
+
+    base = (
+        "tempo: 60\n0 1 right_support place low\n0 1 left_leg forward low\n1 1/2 support air\n"
+        "3/2 1/2 {lander}_support place low\n2 1 turn {way} amount=1/2\n"
+    )
+    ref = lab.loads(base.format(lander="right", way="right"))
+    assert compare_scores(ref, ref).exact and compare_scores(ref, ref).symbol_agreement == 1.0
+    # A leap instead of a hop: the support column disagrees during the flight.
+    leap = lab.loads(base.format(lander="left", way="right"))
+    cells = [c for c in agreement_cells(ref, leap, step=F(1, 2)) if c.ref != c.cand]
+    assert ("supports", ("support", "air", "hop"), ("support", "air", "leap")) in [
+        (c.part, c.ref, c.cand) for c in cells
+    ]
+    # Half a turn the other way ends facing the same way, but not at the same front.
+    other = lab.loads(base.format(lander="right", way="left"))
+    bad = [c for c in agreement_cells(ref, other) if c.ref != c.cand]
+    assert {c.part for c in bad} == {"front"} and bad[-1].ref == ("1/2",) and bad[-1].cand == ("-1/2",)
+    assert not compare_scores(ref, other).exact
+    # At another tempo, turns keep their amounts.
+    doubled = tuple(
+        Symbol(s.start * 2, s.duration * 2, s.part, s.direction, s.level, s.bend, s.amount) for s in ref.symbols
+    )
+    assert compare_scores(ref, ref.replace(tempo=120, symbols=doubled)).exact

@@ -11,7 +11,7 @@ from fractions import Fraction
 from hypothesis import strategies as st
 
 from capture2notation.notation import DIRECTIONS, EMOTIONS, GESTURE_PARTS, LEVELS, PARTS, Effort, Score, Symbol
-from capture2notation.notation.model import BENDABLE_PARTS
+from capture2notation.notation.model import AXES, BENDABLE_PARTS, TURN_PART
 
 beats = st.fractions(min_value=0, max_value=16, max_denominator=12)
 durations = st.fractions(min_value=Fraction(1, 12), max_value=8, max_denominator=12)
@@ -36,8 +36,22 @@ def scores(draw, max_symbols: int = 12):
         part = draw(st.sampled_from(PARTS))
         start = next_free.get(part, Fraction(0)) + draw(beats)
         duration = draw(durations)
-        direction, level, bend = draw(symbol_fields(part))
-        symbols.append(Symbol(start, duration, part, direction, level, bend))
+        if part == TURN_PART:
+            direction = draw(st.sampled_from(["right", "left"]))
+            amount = Fraction(draw(st.integers(1, 24)), 8)
+            symbols.append(Symbol(start, duration, part, direction, None, amount=amount))
+        elif part == "support" and draw(st.integers(0, 3)) == 0:
+            # Flight: no foot support may overlap it, so it starts after them all.
+            start = max([start] + [v for k, v in next_free.items() if k.endswith("support")])
+            symbols.append(Symbol(start, duration, part, "air", None))
+            for k in ("right_support", "left_support"):
+                next_free[k] = max(next_free.get(k, Fraction(0)), start + duration)
+        else:
+            direction, level, bend = draw(symbol_fields(part))
+            if part.endswith("_support"):
+                # ... and no foot support may overlap an earlier flight.
+                start = max(start, next_free.get("support", Fraction(0)))
+            symbols.append(Symbol(start, duration, part, direction, level, bend))
         next_free[part] = start + duration
     which = draw(st.sampled_from(["none", "effort", "emotion"]))
     effort = emotion = None
@@ -50,9 +64,12 @@ def scores(draw, max_symbols: int = 12):
     elif which == "emotion":
         emotion = draw(st.sampled_from(EMOTIONS))
     title = draw(st.text(max_size=30).filter(lambda t: "\n" not in t))
-    tempo = draw(st.fractions(min_value=Fraction(1, 4), max_value=300, max_denominator=8))
+    tempo = draw(st.fractions(min_value=10, max_value=300, max_denominator=8))
     meter = draw(st.integers(1, 12))
-    return Score(symbols=tuple(symbols), title=title, tempo=tempo, meter=meter, effort=effort, emotion=emotion)
+    axes = draw(st.sampled_from(AXES))
+    return Score(
+        symbols=tuple(symbols), title=title, tempo=tempo, meter=meter, effort=effort, emotion=emotion, axes=axes
+    )
 
 
 st.register_type_strategy(Score, scores())

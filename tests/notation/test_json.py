@@ -148,3 +148,51 @@ def test_any_dict_builds_or_raises_score_format_error(data):
         assert str(exc).startswith("fuzz.json:")
     else:
         assert score_from_dict(score_to_dict(score)) == score
+
+
+def test_turns_flight_and_key_in_json():
+    s = lab.loads(
+        "axes: body\n0 1 right_support place low\n0 1 left_leg forward low\n0 1 turn left amount=3/8\n"
+        "1 1/2 support air\n3/2 1/2 left_support forward low\n"
+    )
+    d = json_format.score_to_dict(s)
+    assert d["version"] == 2 and d["axes"] == "body"
+    turn = next(x for x in d["symbols"] if x["part"] == "turn")
+    assert turn["amount"] == "3/8" and turn["level"] is None and "spring" not in turn
+    air = next(x for x in d["symbols"] if x["direction"] == "air")
+    assert air["spring"] == "leap" and air["level"] is None and "amount" not in air
+    assert json_format.score_from_dict(d) == s
+    # A spring form that the supports contradict is refused, naming the field.
+    air["spring"] = "hop"
+    with pytest.raises(ScoreFormatError, match=r"symbols\[\d\]\.spring: \"hop\" does not match .* leap"):
+        json_format.score_from_dict(d, "s.json")
+    # Version 1 files (no turns, no key) still read.
+    v1 = {
+        "version": 1,
+        "symbols": [{"start": 0, "duration": 1, "part": "head", "direction": "forward", "level": "high"}],
+    }
+    assert json_format.score_from_dict(v1).axes == "standard"
+
+
+@pytest.mark.parametrize(
+    "text,fragment",
+    [
+        ("[" * 100000 + "]" * 100000, "nested too deeply"),
+        ('{"tempo": ' + "9" * 5000 + "}", "invalid JSON"),
+        ('{"tempo": "1e100000000"}', "tempo: .*not a number"),
+        ('{"tempo": 1e-300}', "not an exact fraction"),
+        ('{"tempo": 0.5}', "outside 10-400"),
+        (
+            '{"symbols": [{"start": 1e9, "duration": 1, "part": "head", "direction": "forward", "level": "high"}]}',
+            "exceeds the limit",
+        ),
+        (
+            '{"symbols": [{"start": 0, "duration": 1, "part": "turn", "direction": "right", "level": null}]}',
+            "needs amount",
+        ),
+    ],
+)
+def test_json_guards_fail_with_one_line(text, fragment):
+    with pytest.raises(ScoreFormatError, match=fragment) as info:
+        json_format.loads(text, "g.json")
+    assert "\n" not in str(info.value)

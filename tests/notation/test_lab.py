@@ -265,3 +265,80 @@ def test_any_text_parses_or_raises_score_format_error(text):
         assert str(exc).startswith("fuzz.lab:")
     else:
         assert lab.loads(lab.dumps(score)) == score
+
+
+# --- turns, flight, the key and the range guards ---------------------------------
+
+TURNS = """\
+axes: standard                # optional header: standard (default) | body
+# start  duration  part           direction   level / keywords
+4        1         turn           right       amount=1/2     # pivot clockwise half a turn
+4        1         right_support  place       high           # ... on the right foot in relevé
+6        1/2       support        air                        # both feet off the floor
+13/2     1/2       left_support   forward     middle         # landing: a leap onto the left foot
+"""
+
+
+def test_design_turn_example_reads_and_writes_exactly():
+    s = lab.loads(TURNS, "t.lab")
+    assert s.axes == "standard"
+    assert set(s.symbols) == {
+        Symbol(4, 1, "turn", "right", None, amount=Fraction(1, 2)),
+        Symbol(4, 1, "right_support", "place", "high"),
+        Symbol(6, Fraction(1, 2), "support", "air", None),
+        Symbol(Fraction(13, 2), Fraction(1, 2), "left_support", "forward", "middle"),
+    }
+    text = lab.dumps(s)
+    assert "turn             right          amount=1/2" in text and "support          air" in text
+    assert "axes:" not in text  # the default key is not written
+    body = s.replace(axes="body")
+    assert "axes: body" in lab.dumps(body) and lab.loads(lab.dumps(body)) == body
+
+
+@pytest.mark.parametrize(
+    "line,fragment",
+    [
+        ("0 1 turn right", "needs 'amount=F'"),
+        ("0 1 turn right high", "unexpected 'high' in a turn"),
+        ("0 1 turn right amount=1/2 amount=1", "amount is given twice"),
+        ("0 1 turn up amount=1", "unknown turn direction 'up'"),
+        ("0 1 turn right amount=1/3", "multiple of 1/8"),
+        ("0 1 support air low", "flight has no level"),
+        ("0 1 left_support air", "unknown direction 'air'"),
+        ("0 1 head forward", "expected the columns"),
+        ("axes: tilted", "unknown axes 'tilted'"),
+    ],
+)
+def test_turn_and_flight_errors_name_the_line(line, fragment):
+    with pytest.raises(ScoreFormatError, match=fragment) as info:
+        lab.loads(f"tempo: 60\n{line}\n", "t.lab")
+    assert str(info.value).startswith("t.lab:2: ")
+
+
+@pytest.mark.parametrize(
+    "text,fragment",
+    [
+        ("tempo: 1e100000000\n", "tempo '1e100000000' is not a number"),
+        ("tempo: 1/1000\n", "outside 10-400"),
+        ("tempo: " + "9" * 5000 + "\n", "longer than 40"),
+        ("1000000000 1 head forward high\n", "exceeds the limit of 24000 beats"),
+        ("0 1e9 head forward high\n", "is not a number"),
+        ("meter: 999\n", "exceeds the limit of 64"),
+        ("meter: 10000000000\n", "not a positive whole number"),
+        ("0 3601 head forward high\n", "more than the limit of 3600 s"),
+    ],
+)
+def test_range_guards_fail_fast_with_one_line(text, fragment):
+    with pytest.raises(ScoreFormatError, match=fragment) as info:
+        lab.loads(text, "g.lab")
+    assert "\n" not in str(info.value) and len(str(info.value)) <= 320
+
+
+def test_size_and_symbol_count_guards(tmp_path, monkeypatch):
+    big = tmp_path / "big.lab"
+    big.write_bytes(b"# " + b"x" * (16 * 2**20) + b"\n")
+    with pytest.raises(ScoreFormatError, match="exceed the limit of 16777216"):
+        read(big)
+    monkeypatch.setattr(lab, "MAX_SYMBOLS", 3)
+    with pytest.raises(ScoreFormatError, match=r"g.lab:4: more than 3 symbols"):
+        lab.loads("".join(f"{i} 1 head forward high\n" for i in range(5)), "g.lab")

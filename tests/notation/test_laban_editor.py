@@ -94,7 +94,9 @@ def _collapsed(positions: dict):
     """(ms, state) of the positions where the state changes."""
     out, last = [], None
     for p in positions.values():
-        state = tuple(tuple(p[f]) for f in FIELDS[2:7])
+        word, deg = p["rotation"]
+        front = round((1 if word == "ToRight" else -1) * float(deg) / 45)  # eighths, as the reader rounds
+        state = (*(tuple(p[f]) for f in FIELDS[2:7]), front)
         if state != last:
             out.append((int(p["start time"][0]), state))
             last = state
@@ -112,6 +114,7 @@ def test_write_read_write_keeps_the_key_poses(score):
         "right_forearm",
         "left_upper_arm",
         "left_forearm",
+        "turn",
     }
     original = next(iter(json.loads(text).values()))
     again = next(iter(le.score_to_laban_editor(back).values()))
@@ -153,3 +156,46 @@ def test_reader_errors_name_the_json_path(mutate, fragment):
     with pytest.raises(ScoreFormatError) as info:
         le.loads(json.dumps(d), "laban_editor.json")
     assert str(info.value).startswith("laban_editor.json: ") and fragment in str(info.value), str(info.value)
+
+
+def test_rotation_is_the_front_at_each_position():
+    score = lab.loads("tempo: 60\n0 1 turn right amount=1/4\n1 2 turn left amount=3/4\n1 2 right_arm right middle\n")
+    positions = next(iter(le.score_to_laban_editor(score).values())).values()
+    # Positions at every turn's start and end: 0, 1 s and 3 s.
+    assert [(p["start time"][0], p["rotation"]) for p in positions] == [
+        ("0", ["ToLeft", "0"]),
+        ("1000", ["ToRight", "90"]),
+        ("3000", ["ToLeft", "180"]),
+    ]
+    back = le.loads(le.dumps(score), "x.json")
+    assert [s for s in back.symbols if s.is_turn] == [s for s in score.symbols if s.is_turn]
+
+
+def test_suite_library_rotations_read_as_turns():
+    # MSRAbotChatSimulation's "beat rotate": fronts 0, 30, -30, 0 degrees (ToRight),
+    # rounded to eighths: 1/8 right, 1/4 left, 1/8 right.
+    pose = {"head": ["Forward", "Normal"]}
+    doc = {
+        "beat rotate": {
+            f"Position{i}": {"start time": [t], "duration": ["0"], "rotation": ["ToRight", deg], **pose}
+            for i, (t, deg) in enumerate([("1", "0"), ("500", "30"), ("1500", "-30"), ("2500", "0")])
+        }
+    }
+    turns = [(s.start, s.duration, s.direction, s.amount) for s in le.loads(json.dumps(doc)).symbols if s.is_turn]
+    assert turns == [
+        (Fraction(1, 1000), Fraction(499, 1000), "right", Fraction(1, 8)),
+        (Fraction(1, 2), Fraction(1), "left", Fraction(1, 4)),
+        (Fraction(3, 2), Fraction(1), "right", Fraction(1, 8)),
+    ]
+
+
+@pytest.mark.parametrize(
+    "rotation,fragment",
+    [(["Up", "0"], '"Up"'), (["ToRight", "nan"], '"nan"'), (["ToLeft", 5], "5")],
+)
+def test_bad_rotation_names_the_field(rotation, fragment):
+    doc = {"s": {"Position0": {"start time": ["0"], "rotation": rotation}}}
+    with pytest.raises(
+        ScoreFormatError, match=r"s\.Position0\.rotation: expected \[ToRight\|ToLeft, degrees\], got .*" + fragment
+    ):
+        le.loads(json.dumps(doc), "x.json")

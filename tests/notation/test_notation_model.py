@@ -89,6 +89,7 @@ def test_score_order_does_not_depend_on_input_order(score, rnd):
         meter=score.meter,
         effort=score.effort,
         emotion=score.emotion,
+        axes=score.axes,
     )
     assert again == score
     keys = [s.sort_key() for s in score.symbols]
@@ -110,7 +111,13 @@ def test_overlap_within_a_part_is_rejected_across_parts_allowed():
 @pytest.mark.parametrize(
     "kwargs,fragment",
     [
-        (dict(tempo=0), "tempo 0 must be > 0"),
+        (dict(tempo=0), "tempo 0 is outside 10-400 .*must be > 0"),
+        (dict(tempo=9), "tempo 9 is outside 10-400"),
+        (dict(tempo=401), "tempo 401 is outside"),
+        (dict(meter=65), "at most 64"),
+        (dict(axes="tilted"), "unknown axes 'tilted'"),
+        (dict(title="x" * 1001), "exceeds the limit of 1000"),
+        (dict(symbols=(Symbol(0, 3600, "head", "forward", "high"),), tempo=59), "more than the limit of 3600 s"),
         (dict(meter=0), "meter 0"),
         (dict(meter=True), "meter True"),
         (dict(title="a\nb"), "single line"),
@@ -166,3 +173,65 @@ def test_effort_working_ranges(kwargs):
 def test_effort_edges_are_inside_and_stored_as_float():
     e = Effort(time=-5, weight=0.05, space=1)
     assert e.time == -5.0 and isinstance(e.time, float) and isinstance(e.space, float)
+
+
+@pytest.mark.parametrize(
+    "kwargs,fragment",
+    [
+        (dict(direction="up"), "unknown turn direction 'up'"),
+        (dict(level="high"), "a turn has no level"),
+        (dict(amount=None), "needs amount"),
+        (dict(amount=Fraction(1, 3)), "multiple of 1/8"),
+        (dict(amount=0), "multiple of 1/8"),
+        (dict(amount=33), "at most 32"),
+        (dict(bend=1), "not allowed on a turn"),
+    ],
+)
+def test_turn_validation(kwargs, fragment):
+    fields = dict(start=0, duration=1, part="turn", direction="right", level=None, amount=Fraction(1, 2)) | kwargs
+    with pytest.raises(NotationError, match=fragment):
+        Symbol(**fields)
+
+
+def test_turns_and_flight_are_level_less_symbols():
+    t = Symbol(0, 1, "turn", "left", None, amount="3/8")
+    assert t.is_turn and not t.is_support and t.amount == Fraction(3, 8) and t.signed_amount == Fraction(-3, 8)
+    a = Symbol(1, "1/2", "support", "air", None)
+    assert a.is_air and a.is_support and a.signed_amount == 0
+    for bad, fragment in [
+        (dict(part="right_support"), "unknown direction 'air'"),
+        (dict(level="low"), "support air has no level"),
+        (dict(amount=1), "belongs to turn symbols only"),
+    ]:
+        with pytest.raises(NotationError, match=fragment):
+            Symbol(**(dict(start=0, duration=1, part="support", direction="air", level=None) | bad))
+    with pytest.raises(NotationError, match="unknown level None"):
+        Symbol(0, 1, "head", "forward", None)
+
+
+def test_no_foot_support_overlaps_flight():
+    air = Symbol(2, 1, "support", "air", None)
+    Score(symbols=(Symbol(0, 2, "right_support", "place", "low"), air, Symbol(3, 1, "left_support", "place", "low")))
+    with pytest.raises(NotationError, match="overlaps support air"):
+        Score(symbols=(Symbol(1, "3/2", "right_support", "place", "low"), air))
+
+
+@pytest.mark.parametrize(
+    "value,fragment",
+    [("1e100000000", "not a number"), ("1_000", "not a number"), ("9" * 41, "longer than 40"), ("1/0", "divides")],
+)
+def test_number_tokens_are_guarded(value, fragment):
+    with pytest.raises(NotationError, match=fragment):
+        as_fraction(value, "start")
+
+
+def test_beats_are_bounded():
+    from capture2notation.notation.limits import MAX_BEATS
+
+    Symbol(MAX_BEATS - 1, 1, "head", "forward", "high")
+    with pytest.raises(NotationError, match="exceeds the limit"):
+        Symbol(10**9, 1, "head", "forward", "high")
+    with pytest.raises(NotationError, match="exceeds the limit"):
+        Symbol(0, MAX_BEATS + 1, "head", "forward", "high")
+    with pytest.raises(NotationError, match="finite"):
+        as_fraction(float("inf"), "start")

@@ -72,6 +72,9 @@ def test_vertical_extent_is_proportional_to_duration(score, measures_per_staff):
     assert len(groups) == len(score.symbols)
     for g in groups:
         dur = Fraction(g.get("data-duration"))
+        if g.get("data-direction") == "air":  # flight is a gap: no outline
+            assert g.find(f"{SVG}polygon") is None and g.find(f"{SVG}text").text
+            continue
         assert _polygon_y_extent(g) == pytest.approx(40.0 * float(dur), abs=0.02)
 
 
@@ -88,6 +91,68 @@ def test_time_runs_bottom_to_top_and_sides():
     # Column order outwards on the right: support, leg, body, arm, head.
     x = {p: by_part[p][0].centre[0] for p in ("right_support", "chest", "right_arm", "head")}
     assert x["right_support"] < x["chest"] < x["right_arm"] < x["head"]
+
+
+TURNING = lab.loads("""\
+title: turns and springs
+tempo: 60
+0 2 support place middle
+2 1 right_support place high
+2 1 turn right amount=1/2
+2 1 left_leg forward low
+3 1 support place low
+4 1/2 support air
+9/2 1 support place low
+11/2 1/2 right_support place low
+6 1/2 support air
+13/2 1/2 left_support forward low
+6 2 right_leg back middle
+7 1 turn left amount=1/4
+""")
+
+
+def test_turns_sit_in_the_support_column_of_their_foot():
+    lay = staff_layout(TURNING, column_width=30.0)
+    turns = [g for g in lay.glyphs if g.symbol.is_turn]
+    centre = lay.glyphs[0].centre[0]  # `support` spans both columns, centred on the centre line
+    on_right, on_left = turns
+    # Half a turn on the right foot in relevé: inner half of the right support column,
+    # the relevé keeping the outer half; its pin points down (half a turn).
+    xr = on_right.pieces[0][:, 0]
+    rel = next(g for g in lay.glyphs if g.symbol.part == "right_support" and g.symbol.level == "high")
+    assert centre < xr.min() and xr.max() <= rel.pieces[0][:, 0].min() + 1e-9
+    assert on_right.pin == pytest.approx(180.0) and on_right.label == "R 1/2"
+    # A quarter turn left on the left foot: the whole left support column, pin to the left.
+    xl = on_left.pieces[0][:, 0]
+    assert xl.max() < centre and xl.max() - xl.min() == pytest.approx(30.0 * (1 - 2 * 0.12))
+    assert on_left.pin == pytest.approx(270.0) and on_left.label == "L 1/4"
+    # Right turns slant down to the right: their right corners are the lower ones (larger y).
+    pts = on_right.pieces[0]
+    assert pts[pts[:, 0].argmax(), 1] > pts[pts[:, 0].argmin(), 1]
+
+
+def test_a_front_sign_follows_every_turn(tmp_path):
+    lay = staff_layout(TURNING)
+    assert [(f.front, f.room) for f in lay.fronts] == [(Fraction(1, 2), "back"), (Fraction(1, 4), "right")]
+    turns = [g for g in lay.glyphs if g.symbol.is_turn]
+    for f, g in zip(lay.fronts, turns):
+        staff_left = min(p[:, 0].min() for gl in lay.glyphs for p in gl.pieces)
+        assert f.centre[0] < staff_left  # beside the staff
+        top = min(p[:, 1].min() for p in g.pieces)
+        assert f.centre[1] == pytest.approx(top - f.size / 2 - 2)  # just after the turn ends
+    assert lay.fronts[0].pin == pytest.approx(180.0) and lay.fronts[1].pin == pytest.approx(90.0)
+    root = ET.parse(render_staff(TURNING, tmp_path / "t.svg", tmp_path / "t.png")).getroot()
+    signs = [g for g in root.iter(f"{SVG}g") if g.get("class") == "front-sign"]
+    assert [g.get("data-room") for g in signs] == ["back", "right"]
+
+
+def test_flight_is_a_gap_named_by_its_spring_form(tmp_path):
+    root = ET.parse(render_staff(TURNING, tmp_path / "t.svg")).getroot()
+    airs = [g for g in _symbol_groups(root) if g.get("data-direction") == "air"]
+    assert [g.get("data-spring") for g in airs] == ["jump", "leap"]
+    for g in airs:
+        assert g.find(f"{SVG}polygon") is None
+        assert g.find(f"{SVG}text").text == g.get("data-spring")
 
 
 def test_levels_and_bend_marks(tmp_path):

@@ -101,3 +101,16 @@ def test_bad_frames_are_named():
     joints, _ = _poses({})
     with pytest.raises(QuantiseError, match="key frame 5"):
         benesh_key_poses(joints, [5], fps=25)
+
+
+def test_key_poses_record_the_unwrapped_facing():
+    from capture2notation.notation.formats import lab
+    from synthetic import interpret
+
+    score = lab.loads("tempo: 60\n0 1 turn right amount=1\n1 1 turn right amount=1/2\n2 1 turn left amount=1/4\n")
+    m = interpret(score, fps=25)
+    stave, poses = benesh_key_poses(m.joints(), [0, 25, 50, 75], 25)
+    # One full turn, then a half, then back a quarter: 360, 540, 450 degrees (unwrapped).
+    assert [round(p.facing, 6) for p in poses] == [0.0, 360.0, 540.0, 450.0]
+    doc = json.loads(benesh_json(stave, poses))
+    assert [p["facing"] for p in doc["poses"]] == [0.0, 360.0, 540.0, 450.0]

@@ -23,6 +23,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ...errors import ScoreFormatError
+from ..limits import MAX_SCORE_BYTES
 from ..model import Score
 
 __all__ = [
@@ -144,13 +145,18 @@ def read(path, format: str | None = None) -> Score:
     Raises
     ------
     ScoreFormatError
-        Unreadable file, unknown format, or malformed content (the message
-        names the file, the line and what was expected).
+        Unreadable file, unknown format, a file over
+        :data:`~capture2notation.notation.limits.MAX_SCORE_BYTES`, or
+        malformed content (the message names the file, the line and what
+        was expected).
     """
     fmt = format_for(path, format)
     if fmt.loads is None:
         raise ScoreFormatError(f"the {fmt.name} format can be written but not read", str(path))
     try:
+        size = Path(path).stat().st_size
+        if size > MAX_SCORE_BYTES:
+            raise ScoreFormatError(f"{size} bytes exceed the limit of {MAX_SCORE_BYTES} for a score file", str(path))
         text = Path(path).read_text(encoding="utf-8")
     except OSError as exc:
         raise ScoreFormatError(f"cannot read score file: {exc.strerror or exc}", str(path)) from None

@@ -23,8 +23,16 @@ symbol says otherwise); then one position per distinct time at which an arm
 or head symbol arrives, holding every part's state at that time.
 ``duration`` is the time in ms since the previous position (the suite's own
 exporter writes placeholders ``"1"``/``"-1"`` there and its viewer uses only
-the start times).  ``rotation`` is always ``["ToLeft", "0"]``: we do not
-notate turns.  Legs, chest and supports have no column in this format.
+the start times).  Legs, chest and supports have no column in this format.
+
+``rotation`` is ``[ToRight|ToLeft, degrees]``: the front at that position,
+in degrees from the starting front, clockwise for ``ToRight``.  That is how
+the suite's own gesture library uses the field (``MSRAbotChatSimulation/
+data/LabanotationLibrary``: "beat rotate" writes 0, 30, −30, 0 and "deictic
+me rotate l" 10, 60, 60, 0 — a front held and returned to, not increments;
+negative ``ToRight`` values are fronts to the left); its exporter always
+writes ``["ToLeft", "0"]``, which we write for front 0 as well.  Positions
+are added at the start and end of every turn, so each turn's span survives.
 
 A whole-arm symbol with bend k is split into upper arm and forearm with a
 simple, documented convention: both segments taken of equal length, the
@@ -41,13 +49,19 @@ Reading
 Positions become symbols of ``right_upper_arm``, ``right_forearm``,
 ``left_upper_arm``, ``left_forearm`` and ``head``: a part whose state
 differs from the previous position moves from that position's time to this
-one.  Times become beats at tempo 60 (1 beat = 1000 ms) and the title is the
-score's name.
+one.  A change of ``rotation`` between positions becomes a turn over the
+same span, the fronts rounded to the nearest eighth of a turn (the suite
+writes 30° or 60°; our turns are eighths), measured from the first
+position's rotation.  Times become beats at tempo 60 (1 beat = 1000 ms) and
+the title is the score's name.  Range guards: the text at most 16 MiB,
+numbers at most 40 characters, at most 50,000 positions.
 """
 
 from __future__ import annotations
 
 import json
+import math
+import re
 from fractions import Fraction
 from pathlib import Path
 from types import MappingProxyType
@@ -56,7 +70,10 @@ import numpy as np
 
 from ...errors import NotationError, ScoreFormatError
 from ..directions import BEND_STEP_DEG, canonical_vector, classify
-from ..model import Score, Symbol
+from ..facing import front_lookup
+from ..limits import MAX_NUMBER_CHARS, MAX_SYMBOLS
+from ..model import TURN_PART, TURN_STEP, Score, Symbol
+from .json_format import load_json
 
 __all__ = [
     "DIRECTION_NAMES",
@@ -101,7 +118,7 @@ _START = {
     "left_upper_arm": ("place", "low"),
     "left_forearm": ("place", "low"),
 }
-_ROTATION = ["ToLeft", "0"]
+_ROTATION_WORDS = {"ToRight": 1, "ToLeft": -1}
 _ANY_ARM_OR_HEAD = frozenset(
     {"head", "right_arm", "left_arm", "right_upper_arm", "right_forearm", "left_upper_arm", "left_forearm"}
 )
@@ -153,10 +170,12 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
         Key of the score; default the title, or ``"score"`` if it is empty.
     """
     relevant = [s for s in score.symbols if s.part in _ANY_ARM_OR_HEAD]
-    times = sorted({Fraction(0)} | {s.end for s in relevant})
+    turns = [s for s in score.symbols if s.is_turn]
+    times = sorted({Fraction(0)} | {s.end for s in relevant} | {t for s in turns for t in (s.start, s.end)})
     # Apply symbols in order of arrival; a later symbol on a segment wins.
     events = sorted(relevant, key=lambda s: (s.end, s.start))
     state = dict(_START)
+    front_at = front_lookup(score)
     positions: dict = {}
     k = 0
     prev_ms = 0
@@ -175,10 +194,17 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
         for field, part, _, _ in _FIELDS:
             d, lv = state[part]
             pose[field] = [DIRECTION_NAMES[d], LEVEL_NAMES[lv]]
-        pose["rotation"] = list(_ROTATION)
+        pose["rotation"] = _rotation(front_at(t))
         positions[f"Position{len(positions)}"] = pose
         prev_ms = ms
     return {name or score.title or "score": positions}
+
+
+def _rotation(front: Fraction) -> list[str]:
+    """``[ToRight|ToLeft, degrees]`` of a front in full turns clockwise."""
+    deg = abs(front) * 360
+    text = str(deg.numerator) if deg.denominator == 1 else repr(float(deg))
+    return ["ToRight" if front > 0 else "ToLeft", text]
 
 
 def dumps(score: Score, name: str | None = None) -> str:
@@ -205,7 +231,7 @@ def write_laban_editor(score: Score, path, name: str | None = None) -> Path:
 
 def _pair(value, where: str, path) -> tuple[str, str]:
     if not (isinstance(value, list) and len(value) == 2 and all(isinstance(x, str) for x in value)):
-        raise ScoreFormatError(f"{where}: expected [Direction, Level] strings, got {json.dumps(value)}", path)
+        raise ScoreFormatError(f"{where}: expected [Direction, Level] strings, got {_show(value)}", path)
     d, lv = value
     if d not in _DIRECTION_BACK:
         raise ScoreFormatError(f"{where}: unknown direction {d!r}; expected one of {', '.join(_DIRECTION_BACK)}", path)
@@ -216,12 +242,38 @@ def _pair(value, where: str, path) -> tuple[str, str]:
 
 def _time_ms(value, where: str, path) -> int:
     raw = value[0] if isinstance(value, list) and len(value) == 1 else value
+    bad = ScoreFormatError(f"{where}: expected [milliseconds] as a whole number, got {_show(value)}", path)
+    if isinstance(raw, bool) or not isinstance(raw, (str, int)):
+        raise bad
+    text = str(raw).strip() if isinstance(raw, str) else None
+    if text is not None and (len(text) > MAX_NUMBER_CHARS or not re.fullmatch(r"[+-]?[0-9]+", text)):
+        raise bad
+    return int(raw)
+
+
+def _front_eighths(value, where: str, path) -> int:
+    """Front of a ``rotation`` field in eighths of a turn clockwise (nearest)."""
+    bad = f"{where}: expected [ToRight|ToLeft, degrees], got {_show(value)}"
+    if not (isinstance(value, list) and len(value) == 2 and all(isinstance(x, str) for x in value)):
+        raise ScoreFormatError(bad, path)
+    word, deg_text = value
+    if word not in _ROTATION_WORDS or len(deg_text) > MAX_NUMBER_CHARS:
+        raise ScoreFormatError(bad, path)
     try:
-        return int(str(raw))
+        deg = float(deg_text)
     except ValueError:
-        raise ScoreFormatError(
-            f"{where}: expected [milliseconds] as a whole number, got {json.dumps(value)}", path
-        ) from None
+        raise ScoreFormatError(bad, path) from None
+    if not math.isfinite(deg):
+        raise ScoreFormatError(bad, path)
+    return round(_ROTATION_WORDS[word] * deg / float(360 * TURN_STEP))
+
+
+def _show(value) -> str:
+    try:
+        text = json.dumps(value, ensure_ascii=False)
+    except (TypeError, ValueError, RecursionError):
+        text = type(value).__name__
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def loads(text: str, path: str | None = None) -> Score:
@@ -233,16 +285,16 @@ def loads(text: str, path: str | None = None) -> Score:
         Naming the JSON path (``NAME.Position3.right elbow``) and what was
         expected.
     """
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ScoreFormatError(f"invalid JSON: {exc.msg} (column {exc.colno})", path, exc.lineno) from None
+    data = load_json(text, path)
     if not isinstance(data, dict) or len(data) != 1 or not isinstance(next(iter(data.values())), dict):
         raise ScoreFormatError('expected one score: {name: {"Position0": {...}, ...}}', path)
     name, positions = next(iter(data.items()))
+    if len(positions) > MAX_SYMBOLS:
+        raise ScoreFormatError(f"{len(positions)} positions exceed the limit of {MAX_SYMBOLS} in one score", path)
+    label = json.dumps(name, ensure_ascii=False)[1:-1][:60]  # one line, whatever the name holds
     poses = []
     for key, pose in positions.items():
-        where = f"{name}.{key}"
+        where = f"{label}.{json.dumps(key, ensure_ascii=False)[1:-1][:60]}"
         if not isinstance(pose, dict):
             raise ScoreFormatError(f"{where}: expected an object", path)
         if "start time" not in pose:
@@ -252,23 +304,36 @@ def loads(text: str, path: str | None = None) -> Score:
         for field, part, _, _ in _FIELDS:
             if field in pose:
                 state[part] = _pair(pose[field], f"{where}.{field}", path)
-        poses.append((ms, where, state))
+        front = _front_eighths(pose["rotation"], f"{where}.rotation", path) if "rotation" in pose else None
+        poses.append((ms, where, state, front))
     poses.sort(key=lambda p: p[0])
     symbols = []
     prev_ms, current = 0, dict(_START)
-    for ms, where, state in poses:
-        for part, target in state.items():
-            if target == current[part]:
-                continue
+    front0 = next((p[3] for p in poses if p[3] is not None), 0)
+    current_front = front0
+    for ms, where, state, front in poses:
+        changes: list[tuple[str, tuple[str, str] | int]] = [
+            (part, target) for part, target in state.items() if target != current[part]
+        ]
+        if front is not None and front != current_front:
+            changes.append((TURN_PART, front))
+        for part, target in changes:
             if ms <= prev_ms:
                 raise ScoreFormatError(
                     f"{where}: {part} changes at {ms} ms with no time to move since {prev_ms} ms", path
                 )
+            start, dur = Fraction(prev_ms, 1000), Fraction(ms - prev_ms, 1000)
             try:
-                symbols.append(Symbol(Fraction(prev_ms, 1000), Fraction(ms - prev_ms, 1000), part, *target))
+                if isinstance(target, int):
+                    delta = (target - current_front) * TURN_STEP
+                    direction = "right" if delta > 0 else "left"
+                    symbols.append(Symbol(start, dur, TURN_PART, direction, None, amount=abs(delta)))
+                    current_front = target
+                else:
+                    symbols.append(Symbol(start, dur, part, *target))
+                    current[part] = target
             except NotationError as exc:
                 raise ScoreFormatError(f"{where}: {exc}", path) from None
-            current[part] = target
         prev_ms = ms
     try:
         return Score(symbols=tuple(symbols), title=str(name).replace("\n", " "), tempo=Fraction(60), meter=4)

@@ -21,7 +21,8 @@ Five whitespace-separated columns per line::
 
 The coded input carries no tempo, meter or title; this reader uses tempo 60
 beats per minute, meter 4 and the file's stem as the title (the thesis reads
-the tempo separately, with the cine rate).  Blank lines, ``#`` comments and a
+the tempo separately, with the cine rate); range guards as for ``.lab``
+(numbers at most 40 characters, at most 50,000 symbols, 16 MiB).  Blank lines, ``#`` comments and a
 leading column-heading line starting with ``Type`` are skipped.  Writing this
 format is not supported: scores are written as ``.lab`` or ``.json``.
 """
@@ -34,6 +35,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ...errors import NotationError, ScoreFormatError
+from ..limits import MAX_SCORE_BYTES, MAX_SYMBOLS, MAX_TITLE_CHARS
 from ..model import Score, Symbol
 from .lab import check_overlaps, parse_fraction
 
@@ -114,6 +116,8 @@ def loads(text: str, path: str | None = None) -> Score:
     ScoreFormatError
         Naming the file, the line, the bad token and what was expected.
     """
+    if len(text) > MAX_SCORE_BYTES:
+        raise ScoreFormatError(f"{len(text)} characters exceed the limit of {MAX_SCORE_BYTES} for a score", path)
     rows: list[tuple[Symbol, int]] = []
     seen_data = False
     text = text.removeprefix("\ufeff")  # byte-order mark left by some editors
@@ -136,9 +140,14 @@ def loads(text: str, path: str | None = None) -> Score:
                 raise NotationError(
                     f"expected the columns 'type start part duration code', got {len(tokens)}: {line!r}"
                 )
+            if len(rows) >= MAX_SYMBOLS:
+                raise NotationError(f"more than {MAX_SYMBOLS} symbols, the limit for one score")
             rows.append((_symbol(tokens), lineno))
         except NotationError as exc:
             raise ScoreFormatError(str(exc), path, lineno) from None
     check_overlaps(rows, path)
-    title = Path(path).stem.replace("\n", " ") if path else ""
-    return Score(symbols=tuple(s for s, _ in rows), title=title, tempo=DEFAULT_TEMPO, meter=DEFAULT_METER)
+    title = Path(path).stem.replace("\n", " ")[:MAX_TITLE_CHARS] if path else ""
+    try:
+        return Score(symbols=tuple(s for s, _ in rows), title=title, tempo=DEFAULT_TEMPO, meter=DEFAULT_METER)
+    except NotationError as exc:
+        raise ScoreFormatError(str(exc), path) from None

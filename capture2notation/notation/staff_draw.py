@@ -1,0 +1,219 @@
+"""Drawing a :class:`~capture2notation.notation.staff.StaffLayout`: SVG text and a matplotlib PNG.
+
+Both back ends draw the same geometry: outlines filled by level (hatched
+high, a dot for middle, black low), turn pins and amounts, spring forms in
+flight gaps, bend marks, and the front signs beside the staff.
+"""
+
+from __future__ import annotations
+
+import re
+from xml.sax.saxutils import escape, quoteattr
+
+import numpy as np
+
+from .staff_layout import FrontSign, Glyph, StaffLayout
+
+__all__ = ["render_png", "svg_text"]
+
+
+def _hatch_pattern() -> str:
+    return (
+        '<pattern id="hatch" patternUnits="userSpaceOnUse" width="6" height="6" '
+        'patternTransform="rotate(45)"><rect width="6" height="6" fill="white"/>'
+        '<line x1="0" y1="0" x2="0" y2="6" stroke="black" stroke-width="1.6"/></pattern>'
+    )
+
+
+_XML_INVALID = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff\ud800-\udfff]")
+
+
+def _xml_text(text: str) -> str:
+    """Escaped text with the characters XML 1.0 forbids replaced by U+FFFD."""
+    return escape(_XML_INVALID.sub("\ufffd", text))
+
+
+def _pin_end(cx: float, cy: float, deg: float, r: float) -> tuple[float, float]:
+    """Point at `r` pixels from (cx, cy), `deg` degrees clockwise from up (y grows down)."""
+    a = np.radians(deg)
+    return cx + r * float(np.sin(a)), cy - r * float(np.cos(a))
+
+
+def _glyph_svg(g: Glyph) -> str:
+    s = g.symbol
+    level = s.level or "none"
+    fill = {"high": "url(#hatch)", "middle": "white", "low": "black", "none": "white"}[level]
+    attrs = (
+        f'id="sym-{g.index}" class="symbol part-{s.part} dir-{s.direction} level-{level}" '
+        f'data-part="{s.part}" data-direction="{s.direction}" data-level="{s.level or ""}" '
+        f'data-bend="{s.bend}" data-start="{s.start}" data-duration="{s.duration}"'
+    )
+    if s.amount is not None:
+        attrs += f' data-amount="{s.amount}"'
+    if s.is_air:
+        attrs += f' data-spring="{g.label}"'
+    what = f"{s.part} {s.direction} {s.level or ''}".rstrip()
+    if s.amount is not None:
+        what += f" amount={s.amount}"
+    if s.is_air:
+        what += f" ({g.label})"
+    out = [f"<g {attrs}>", f"<title>{escape(f'{what} beat {s.start}+{s.duration}')}</title>"]
+    for piece in g.pieces:
+        pts = " ".join(f"{x:.2f},{y:.2f}" for x, y in piece)
+        out.append(f'<polygon class="outline" points="{pts}" fill="{fill}" stroke="black" stroke-width="1.5"/>')
+    if s.level == "middle":
+        cx, cy = g.centre
+        out.append(f'<circle class="dot" cx="{cx:.2f}" cy="{cy:.2f}" r="{g.dot_radius:.2f}" fill="black"/>')
+    if g.pin is not None:
+        cx, cy = g.centre
+        r = 2.2 * g.dot_radius
+        tx, ty = _pin_end(cx, cy, g.pin, r)
+        out.append(
+            f'<line class="pin" x1="{cx:.2f}" y1="{cy:.2f}" x2="{tx:.2f}" y2="{ty:.2f}" stroke="black" '
+            f'stroke-width="1.4"/><circle cx="{tx:.2f}" cy="{ty:.2f}" r="1.8" fill="black"/>'
+        )
+    if g.label:
+        cx, cy = g.foot if s.is_turn else g.centre
+        dy = -4.0 if s.is_turn else 3.0
+        style = ' font-style="italic"' if s.is_air else ""
+        cls = "amount" if s.is_turn else "spring"
+        out.append(
+            f'<text class="{cls}" x="{cx:.2f}" y="{cy + dy:.2f}" font-size="9" text-anchor="middle" '
+            f'font-family="sans-serif"{style}>{escape(g.label)}</text>'
+        )
+    if s.bend:
+        bx, by = g.foot[0], g.foot[1] - 3
+        out.append(
+            f'<rect x="{bx - 9:.2f}" y="{by - 11:.2f}" width="18" height="12" '
+            'fill="white" stroke="black" stroke-width="0.6"/>'
+            f'<text class="bend" x="{bx:.2f}" y="{by - 1.5:.2f}" font-size="10" text-anchor="middle" '
+            f'font-family="sans-serif">\u00d7{s.bend}</text>'
+        )
+    out.append("</g>")
+    return "".join(out)
+
+
+def _front_svg(f: FrontSign) -> str:
+    cx, cy = f.centre
+    h = f.size / 2
+    tx, ty = _pin_end(cx, cy, f.pin, 0.8 * h)
+    return (
+        f'<g class="front-sign" data-front="{f.front}" data-room="{f.room}">'
+        f"<title>front: {f.room} ({f.front} turns)</title>"
+        f'<rect x="{cx - h:.2f}" y="{cy - h:.2f}" width="{f.size:.2f}" height="{f.size:.2f}" fill="white" '
+        'stroke="black" stroke-width="1"/>'
+        f'<line x1="{cx:.2f}" y1="{cy:.2f}" x2="{tx:.2f}" y2="{ty:.2f}" stroke="black" stroke-width="1.6"/>'
+        f'<circle cx="{tx:.2f}" cy="{ty:.2f}" r="2" fill="black"/>'
+        f'<text x="{cx:.2f}" y="{cy + h + 9:.2f}" font-size="7" text-anchor="middle" '
+        f'font-family="sans-serif">{escape(f.room)}</text></g>'
+    )
+
+
+def svg_text(lay: StaffLayout) -> str:
+    """SVG document of a layout."""
+    parts = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        (
+            f'<svg xmlns="http://www.w3.org/2000/svg" width="{lay.width:.0f}" height="{lay.height:.0f}" '
+            f'viewBox="0 0 {lay.width:.2f} {lay.height:.2f}">'
+        ),
+        f"<defs>{_hatch_pattern()}</defs>",
+        f'<rect width="{lay.width:.2f}" height="{lay.height:.2f}" fill="white"/>',
+        '<g class="staff" stroke="black">',
+    ]
+    for x0, y0, x1, y1, sw in lay.lines:
+        parts.append(f'<line x1="{x0:.2f}" y1="{y0:.2f}" x2="{x1:.2f}" y2="{y1:.2f}" stroke-width="{sw}"/>')
+    parts.append("</g>")
+    parts.append('<g class="labels" font-family="sans-serif">')
+    for x, y, text, size, anchor in lay.texts:
+        parts.append(
+            f'<text x="{x:.2f}" y="{y:.2f}" font-size="{size}" text-anchor={quoteattr(anchor)}>{_xml_text(text)}</text>'
+        )
+    parts.append("</g>")
+    parts.append('<g class="symbols">')
+    parts += [_glyph_svg(g) for g in lay.glyphs]
+    parts.append("</g>")
+    parts.append('<g class="fronts">')
+    parts += [_front_svg(f) for f in lay.fronts]
+    parts.append("</g></svg>")
+    return "\n".join(parts) + "\n"
+
+
+def render_png(lay: StaffLayout, path, dpi: int) -> None:
+    """Write the layout as a PNG (layout pixels at 100 dpi, scaled by ``dpi / 100``), atomically."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Circle, Polygon, Rectangle
+
+    from ..atomic import atomic_path
+
+    # Layout units are pixels at 100 per inch; `dpi` only scales the raster.
+    pt = 72.0 / 100.0
+    fig = Figure(figsize=(lay.width / 100.0, lay.height / 100.0), dpi=dpi)
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_xlim(0, lay.width)
+    ax.set_ylim(lay.height, 0)
+    ax.axis("off")
+    for x0, y0, x1, y1, sw in lay.lines:
+        ax.plot([x0, x1], [y0, y1], color="black", lw=sw * pt, solid_capstyle="butt")
+    align = {"middle": "center", "end": "right", "start": "left"}
+    for x, y, text, size, anchor in lay.texts:
+        ax.text(
+            x,
+            y,
+            _XML_INVALID.sub("\ufffd", text),
+            fontsize=size * pt,
+            ha=align[anchor],
+            va="baseline",
+            family="sans-serif",
+            parse_math=False,
+        )
+    with matplotlib.rc_context({"hatch.linewidth": 1.2}):
+        for g in lay.glyphs:
+            s = g.symbol
+            face = {"high": "white", "middle": "white", "low": "black", None: "white"}[s.level]
+            for piece in g.pieces:
+                ax.add_patch(
+                    Polygon(
+                        piece,
+                        closed=True,
+                        facecolor=face,
+                        edgecolor="black",
+                        lw=1.5 * pt,
+                        hatch="////" if s.level == "high" else None,
+                    )
+                )
+            if s.level == "middle":
+                ax.add_patch(Circle(g.centre, g.dot_radius, color="black"))
+            if g.pin is not None:
+                tx, ty = _pin_end(g.centre[0], g.centre[1], g.pin, 2.2 * g.dot_radius)
+                ax.plot([g.centre[0], tx], [g.centre[1], ty], color="black", lw=1.4 * pt)
+                ax.add_patch(Circle((tx, ty), 1.8, color="black"))
+            if g.label:
+                cx, cy = g.foot if s.is_turn else g.centre
+                ax.text(
+                    cx,
+                    cy + (-4.0 if s.is_turn else 3.0),
+                    g.label,
+                    fontsize=9 * pt,
+                    ha="center",
+                    va="baseline",
+                    style="italic" if s.is_air else "normal",
+                    parse_math=False,
+                )
+            if s.bend:
+                bx, by = g.foot[0], g.foot[1] - 3
+                ax.add_patch(Rectangle((bx - 9, by - 11), 18, 12, facecolor="white", edgecolor="black", lw=0.5))
+                ax.text(bx, by - 1.5, f"\u00d7{s.bend}", fontsize=10 * pt, ha="center", va="baseline")
+        for f in lay.fronts:
+            cx, cy = f.centre
+            h = f.size / 2
+            ax.add_patch(Rectangle((cx - h, cy - h), f.size, f.size, facecolor="white", edgecolor="black", lw=0.7))
+            tx, ty = _pin_end(cx, cy, f.pin, 0.8 * h)
+            ax.plot([cx, tx], [cy, ty], color="black", lw=1.6 * pt)
+            ax.add_patch(Circle((tx, ty), 2.0, color="black"))
+            ax.text(cx, cy + h + 9, f.room, fontsize=7 * pt, ha="center", va="baseline", parse_math=False)
+        with atomic_path(path, suffix=".png") as tmp:
+            fig.savefig(tmp, format="png", dpi=dpi)
