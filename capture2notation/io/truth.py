@@ -203,10 +203,11 @@ def _load_npz(path: Path) -> dict:
     with zf:
         for info in zf.infolist():
             name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
-            if name not in TRUTH_FIELDS or name in arrays:
+            if (name not in TRUTH_FIELDS and name not in OPTIONAL_FIELDS) or name in arrays:
                 what = "repeated" if name in arrays else "unknown"
                 raise MotionFileError(
                     f"{path}: {what} truth field {name!r}; expected each of {', '.join(TRUTH_FIELDS)} once"
+                    f" (optionally {', '.join(OPTIONAL_FIELDS)})"
                 )
             try:
                 with zf.open(info) as fh:
@@ -237,7 +238,7 @@ def _check_header(name: str, shape: tuple, dtype: np.dtype, where: str) -> None:
     text = name in _TEXT
     if dtype.hasobject or dtype.kind not in ("USa" if text else "biuf"):
         raise MotionFileError(f"{where}: field {name} has dtype {dtype}, expected {'text' if text else 'numbers'}")
-    pattern = TRUTH_FIELDS[name]
+    pattern = TRUTH_FIELDS[name] if name in TRUTH_FIELDS else OPTIONAL_FIELDS[name]
     if pattern is None:
         pattern = ()
     elif name == "joint_names":
