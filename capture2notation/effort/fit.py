@@ -282,6 +282,17 @@ _RHO_GRID = np.linspace(-0.5, 0.99, 60)
 _RHO_CHUNK_ELEMENTS = 1 << 21
 
 
+def _seg_sum(key, u, v, k: int, n_seg: int) -> np.ndarray:
+    """Σ of u·v over each (ρ, movement) pair: (k, N) inputs -> (k, n_seg)."""
+    return np.bincount(key, (u * v).ravel(), k * n_seg).reshape(k, n_seg)
+
+
+def _through_line(zz, det, p1, p2, q1, q2) -> np.ndarray:
+    """Σ over movements of pᵀ (ZᵀZ)⁻¹ q with ZᵀZ = [[zz0, zz1], [zz1, zz2]] per (ρ, movement): (k,)."""
+    s11, s12, s22 = zz
+    return np.sum((p1 * (s22 * q1 - s12 * q2) + p2 * (s11 * q2 - s12 * q1)) / det, axis=1)
+
+
 def _ar1_regression(tau, a, y, w, groups=None):
     """Posterior mean and sd of β in ``y = β·a + c_g + d_g·τ + ε`` with AR(1) residuals.
 
@@ -333,22 +344,14 @@ def _ar1_regression(tau, a, y, w, groups=None):
         c = 1.0 / np.sqrt(one_m_phi2)
         z = c[:, None] * (cols[None] - phi[:, None] * prev[None])  # (k, 4, N), whitened
         key = (np.arange(k)[:, None] * n_seg + seg[None, :]).ravel()
-
-        def seg_sum(u, v, key=key, k=k):  # Σ over each (ρ, movement) of u·v -> (k, n_seg)
-            return np.bincount(key, (u * v).ravel(), k * n_seg).reshape(k, n_seg)
-
         z1, z2, za, zy = z[:, 0], z[:, 1], z[:, 2], z[:, 3]
-        s11, s12, s22 = seg_sum(z1, z1), seg_sum(z1, z2), seg_sum(z2, z2)
-        u_a, v_a = seg_sum(z1, za), seg_sum(z2, za)
-        u_y, v_y = seg_sum(z1, zy), seg_sum(z2, zy)
-        det = s11 * s22 - s12 * s12
-
-        def through_line(p1, p2, q1, q2):  # Σ_g p_gᵀ (Z_gᵀ Z_g)⁻¹ q_g -> (k,)
-            return np.sum((p1 * (s22 * q1 - s12 * q2) + p2 * (s11 * q2 - s12 * q1)) / det, axis=1)
-
-        aa = np.sum(za * za, axis=1) - through_line(u_a, v_a, u_a, v_a)
-        ay = np.sum(za * zy, axis=1) - through_line(u_a, v_a, u_y, v_y)
-        yy = np.sum(zy * zy, axis=1) - through_line(u_y, v_y, u_y, v_y)
+        zz = [_seg_sum(key, u, v, k, n_seg) for u, v in ((z1, z1), (z1, z2), (z2, z2))]
+        u_a, v_a = _seg_sum(key, z1, za, k, n_seg), _seg_sum(key, z2, za, k, n_seg)
+        u_y, v_y = _seg_sum(key, z1, zy, k, n_seg), _seg_sum(key, z2, zy, k, n_seg)
+        det = zz[0] * zz[2] - zz[1] * zz[1]
+        aa = np.sum(za * za, axis=1) - _through_line(zz, det, u_a, v_a, u_a, v_a)
+        ay = np.sum(za * zy, axis=1) - _through_line(zz, det, u_a, v_a, u_y, v_y)
+        yy = np.sum(zy * zy, axis=1) - _through_line(zz, det, u_y, v_y, u_y, v_y)
         coef = ay / aa
         rss = np.maximum(yy - ay * coef, 1e-300)
         logdet = np.sum(np.log(det), axis=1) + np.log(aa)
