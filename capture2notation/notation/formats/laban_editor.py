@@ -205,7 +205,7 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
                     arrived[seg] = s.confidence
             k += 1
         ms = _ms(t, score.tempo)
-        pose = {"start time": [str(ms)], "duration": [str(ms - prev_ms)]}
+        pose: dict[str, object] = {"start time": [str(ms)], "duration": [str(ms - prev_ms)]}
         for field, part, _, _ in _FIELDS:
             d, lv = state[part]
             pose[field] = [DIRECTION_NAMES[d], LEVEL_NAMES[lv]]
@@ -290,7 +290,7 @@ def _confidences(value, where: str, path) -> dict[str, float]:
     """Segment → confidence from a position's ``confidence`` object (see the module docstring)."""
     by_field = {field: part for field, part, _, _ in _FIELDS}
     if not isinstance(value, dict):
-        raise ScoreFormatError(f"{where}: expected {{field: \"0.xyz\"}}, got {_show(value)}", path)
+        raise ScoreFormatError(f'{where}: expected {{field: "0.xyz"}}, got {_show(value)}', path)
     out = {}
     for field, text in value.items():
         if field not in by_field:
