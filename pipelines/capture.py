@@ -225,6 +225,7 @@ def capture(
     seed: int = 0,
     overlay: bool = True,
     flip_test: bool = False,
+    axes: str = "standard",
 ) -> CaptureResult:
     """Capture notation from a video or motion file.
 
@@ -257,6 +258,8 @@ def capture(
     flip_test : bool
         BlazePose also reads a mirrored copy of each crop (see
         :class:`capture2notation.keypoints.BlazePose`): more accurate, slower.
+    axes : {"standard", "body"}
+        The score's key (DESIGN.md, "Cross of axes").
 
     Returns
     -------
@@ -280,13 +283,17 @@ def capture(
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
     given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
     try:
-        seg = segment_motion(joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence)
+        seg = segment_motion(
+            joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence, axes=axes
+        )
     except QuantiseError as exc:
         if tempo is not None:
             raise
         # Too few movements for a beat: time as it is, one beat a second, and say so.
         log.warning("capture: no beat found (%s): writing %d bpm, one beat a second", exc, SECONDS_TEMPO)
-        seg = segment_motion(joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title)
+        seg = segment_motion(
+            joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title, axes=axes
+        )
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
