@@ -20,7 +20,9 @@ FPS = 25.0
 
 def _turn_score(turns, tempo=60, axes="standard"):
     """Stand on both feet and turn slowly: `turns` is ``(start, duration, direction, amount)``."""
-    syms = [Symbol(Fraction(s), Fraction(d), "turn", direction, None, amount=Fraction(a)) for s, d, direction, a in turns]
+    syms = [
+        Symbol(Fraction(s), Fraction(d), "turn", direction, None, amount=Fraction(a)) for s, d, direction, a in turns
+    ]
     end = max(s + d for s, d, *_ in turns)
     syms.append(Symbol(Fraction(end), Fraction(1), "right_arm", "forward", "middle"))
     return Score(symbols=tuple(syms), tempo=Fraction(tempo), axes=axes)
