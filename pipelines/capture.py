@@ -471,6 +471,16 @@ def tempo_note(seg, sound: str = "") -> str:
     return f" (estimated from {source}{sure}{other}{why}; give --tempo to fix it)"
 
 
+def emotion_line(data: dict) -> str:
+    """The emotion of an ``effort.json`` in words: the reading, or why it is not read."""
+    if data.get("emotion_text"):
+        return str(data["emotion_text"])
+    emotion = data.get("emotion") or {}
+    if not emotion:
+        return "not read"
+    return " · ".join(f"{k} {v:.0%}" for k, v in sorted(emotion.items(), key=lambda kv: -kv[1]))
+
+
 def _effort_html(files: dict) -> str:
     """The Effort section of the index page: pooled estimate, emotion, plots."""
     if "effort.json" not in files:
@@ -482,8 +492,7 @@ def _effort_html(files: dict) -> str:
         for key, name in (("time", "Time b"), ("weight", "Weight x0"), ("space", "Space S"))
         if key in pooled
     )
-    emotion = data.get("emotion") or {}
-    feelings = " · ".join(f"{html.escape(k)} {v:.0%}" for k, v in sorted(emotion.items(), key=lambda kv: -kv[1]))
+    feelings = html.escape(emotion_line(data))
     converged = (
         "all converged"
         if all(m.get("converged") for m in data.get("movements", []))
@@ -498,7 +507,8 @@ def _effort_html(files: dict) -> str:
         if name in files
     )
     return f"""<h2>Laban Effort (median and 90 % interval)</h2>
-<p>{pooled.get("n_movements", 0)} movements pooled, {converged}. Emotion: {feelings or "not estimated"}.</p>
+<p>{pooled.get("n_movements", 0)} movements pooled, {converged}.</p>
+<p class="emotion">Emotion: {feelings}.</p>
 <table><tr><th>factor</th><th>estimate</th></tr>{rows}</table>
 <div>{plots}</div>"""
 

@@ -17,7 +17,8 @@ from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS, Score
 from .curves import SNAP_S, ProgressCurve, _snap, progress_curve, refine_window
-from .emotion import emotion_probabilities, features
+from .domain import EmotionDomain, emotion_domain
+from .emotion import SPREAD, emotion_probabilities, features
 from .fit import SpaceEstimate
 from .pooled import PooledEffort, curve_space, pool_curves, pooled_space
 from .posterior import Posterior, sample_posteriors
@@ -65,9 +66,12 @@ class EffortResult:
     tempo : float
         Beats per minute, from the symbols' timing (the score's tempo).
     emotion : dict or None
-        ``{happy, sad, angry, afraid: p}``.
+        ``{happy, sad, angry, afraid: p}``; None when not read (see `domain`).
     skipped : tuple of dict
         Movements not measured, with the reason.
+    domain : EmotionDomain or None
+        Whether the phrase is a port de bras the presets describe, check by
+        check; the emotion is read only inside it.
     """
 
     movements: tuple
@@ -76,6 +80,17 @@ class EffortResult:
     tempo: float
     emotion: dict | None
     skipped: tuple = field(default_factory=tuple)
+    domain: EmotionDomain | None = None
+
+    @property
+    def emotion_text(self) -> str:
+        """One line for the terminal and the page: the emotion, or why it is not read."""
+        if self.emotion:
+            best = max(self.emotion, key=self.emotion.get)
+            ranked = sorted(self.emotion.items(), key=lambda kv: -kv[1])
+            return f"{best} ({', '.join(f'{k} {v:.0%}' for k, v in ranked)})"
+        why = "; ".join(self.domain.reasons) if self.domain is not None else "no pooled Effort"
+        return f"not read: {why or 'no pooled Effort'}"
 
     def to_dict(self) -> dict:
         """The JSON-ready content of ``effort.json``."""
@@ -88,6 +103,9 @@ class EffortResult:
             "movements": [_movement_dict(m) for m in self.movements],
             "pooled": pooled,
             "emotion": self.emotion,
+            "emotion_read": self.emotion is not None,
+            "emotion_text": self.emotion_text,
+            "emotion_domain": self.domain.to_dict() if self.domain is not None else None,
             "skipped": list(self.skipped),
         }
 
@@ -314,11 +332,19 @@ def estimate_effort(
         (only,) = by_part
         pooled_all[only] = PooledEffort(only, phrase.n_movements, phrase.posterior, phrase.space)
     tempo = float(score.tempo)
-    emotion = None
-    if phrase is not None:
-        emotion = emotion_probabilities(*_emotion_input(phrase, tempo))
+    x, sd = _emotion_input(phrase, tempo) if phrase is not None else (None, None)
+    domain = emotion_domain(score, [c.part for c in curves], joints, confidence, joint_names, x=x, sd=sd, spread=SPREAD)
+    emotion = emotion_probabilities(x, sd) if domain.inside else None
+    if not domain.inside:
+        log.info("effort: emotion not read: %s", "; ".join(domain.reasons))
     return EffortResult(
-        movements=movements, pooled=phrase, parts=pooled_all, tempo=tempo, emotion=emotion, skipped=tuple(skipped)
+        movements=movements,
+        pooled=phrase,
+        parts=pooled_all,
+        tempo=tempo,
+        emotion=emotion,
+        skipped=tuple(skipped),
+        domain=domain,
     )
 
 

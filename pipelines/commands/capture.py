@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import click
 
 from .options import FPS, TEMPO_OR_NONE, check_outdir
@@ -59,7 +62,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
 
     from capture2notation.errors import PipelineError
     from capture2notation.quantise.segment import SegmentParams
-    from pipelines.capture import NO_TEMPO
+    from pipelines.capture import NO_TEMPO, emotion_line
     from pipelines.capture import capture as run
 
     try:
@@ -87,6 +90,9 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
         f"({result.kind}), tempo {result.score.tempo} bpm{result.tempo_text}"
     )
+    if "effort.json" in result.files:
+        data = json.loads(Path(result.files["effort.json"]).read_text(encoding="utf-8"))
+        click.echo(f"  emotion: {emotion_line(data)}")
     for note in result.skipped:
         click.echo(f"  not written: {note}")
     click.echo(f"  open {result.outdir / 'index.html'}")

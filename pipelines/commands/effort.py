@@ -107,6 +107,4 @@ def effort(capture_dir, seed, workers, no_plots):
     click.echo(
         f"{paths['json']}: {len(result.movements)} movements ({n_conv} converged), {len(result.skipped)} skipped"
     )
-    if result.emotion:
-        best = max(result.emotion, key=result.emotion.get)
-        click.echo("emotion: " + ", ".join(f"{k} {v:.2f}" for k, v in result.emotion.items()) + f" -> {best}")
+    click.echo(f"emotion: {result.emotion_text}")

@@ -315,3 +315,17 @@ def test_one_movement_is_no_beat_and_says_so(tmp_path):
     assert res.score.tempo == 60 and res.segmentation.tempo_source == "no beat"
     assert res.tempo_text.startswith(" (no beat found: one beat a second")
     assert [s.part for s in res.score.symbols] == ["right_arm"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rel", ["mediapipe/pose_squats.mp4", "bvh/jesse_dance.bvh", "bvh/test_mocapbank.bvh"])
+def test_emotion_not_read_outside_the_port_de_bras(rel, fixture_path, tmp_path):
+    """A squat video and the fixture BVH dances are no port de bras: the emotion is not read, with reasons."""
+    out = tmp_path / "c"
+    r = CliRunner().invoke(main, ["capture", str(fixture_path(rel)), "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    data = json.loads((out / "effort.json").read_text(encoding="utf-8"))
+    assert data["emotion"] is None and not data["emotion_read"]
+    assert data["emotion_domain"]["reasons"]
+    assert "emotion: not read: " in r.output
+    assert "Emotion: not read: " in (out / "index.html").read_text(encoding="utf-8")
