@@ -48,6 +48,7 @@ import numpy as np
 from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
 from capture2notation.errors import C2NError, PipelineError, QuantiseError
+from capture2notation.fitting.motion import joints_for_labels
 from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.labels import write_labels_csv
@@ -269,7 +270,7 @@ def capture(
     kind = input_kind(input_path)
     outdir = Path(outdir)
     motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress, flip_test)
-    joints = np.asarray(motion.joints, dtype=float)
+    joints = np.asarray(motion.joints, dtype=float) if kind == "video" else joints_for_labels(motion)
     fps = float(motion.fps)
     if not np.isfinite(joints).any():
         raise PipelineError(f"{input_path}: no frame could be measured (no person found?)")

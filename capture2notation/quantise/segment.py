@@ -76,11 +76,12 @@ from scipy.signal import savgol_filter
 from ..body import joint_index
 from ..errors import QuantiseError
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
+from .flight import find_flights, with_flights
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .measured import held_pose, hold_frames, keep_previous, upright_trunk
 from .movement import Movement
 from .spans import _ZERO_SPEED, movement_spans
-from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
+from .supports import NOISY_POSITION_M, body_height, position_noise, smooth_positions, support_movements
 from .tempo import estimate_tempo_detail, snap
 from .timing import progress_signal, refine_times
 from .travel import unturn
@@ -345,12 +346,22 @@ def segment_motion(
         # raised from the capture's own flat foot, not from the model's.
         flat = flat_foot_pitch(smoothed, contact) if measured else None
         labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat))
+    # Flight from the feet's heights (smoothed when measured), before the supports are written.
+    flights = find_flights(smoothed if noisy_feet else joints, fps, measured, floor)
+    height = body_height(joints)
     estimated = tempo_was_none = tempo is None
     moves, detail = None, None
     if estimated:
         moves = (
             _gesture_movements(labels, joints, fps, params, measured=measured)
-            + support_movements(labels, joints, fps, params, movement_spans, measured=measured)
+            + with_flights(
+                support_movements(labels, joints, fps, params, movement_spans, measured=measured),
+                labels,
+                joints,
+                fps,
+                flights,
+                height,
+            )
             + turn_movements(turning, fps, measured)
         )
         clean = not measured and all(_noise_deg(labels.vectors[:, labels.index(p)]) <= _CLEAN_NOISE_DEG for p in _LIMBS)
@@ -404,7 +415,17 @@ def segment_motion(
         ends[[min(m.end_frame, T - 1) for m in turns]] = True
         moves = (
             _gesture_movements(labels, joints, fps, params, on_grid, measured)
-            + support_movements(labels, joints, fps, params, movement_spans, on_grid, measured=measured, turn_ends=ends)
+            + with_flights(
+                support_movements(
+                    labels, joints, fps, params, movement_spans, on_grid, measured=measured, turn_ends=ends
+                ),
+                labels,
+                joints,
+                fps,
+                flights,
+                height,
+                None if noisy else on_grid,
+            )
             + turns
         )
     moves.sort(key=lambda m: (m.start_time, m.part))

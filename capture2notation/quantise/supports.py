@@ -266,7 +266,7 @@ def support_movements(
     spans = spans_fn(
         speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps, turn_ends)
     )
-    height = _body_height(joints)
+    height = body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
     out = []
     for a, b in spans:
@@ -374,7 +374,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     runs = _feet_that_stay_down(runs, lifted, min_len)
     runs = _no_touch_downs(runs, lifted, min_len)
     runs, passed = _without_passages(runs, smooth[:, joint_index("pelvis"), 2], fps)
-    height = _body_height(smooth)
+    height = body_height(smooth)
     offset = _standing_foot_offset(smooth, labels.supporting)
     pelvis = joints[:, joint_index("pelvis")]
     out = []
@@ -720,7 +720,7 @@ def _pelvis_plie(part: np.ndarray, level: np.ndarray, joints: np.ndarray) -> np.
     if flat.sum() < 5:
         return level
     ref = float(np.percentile(z[flat], 75))
-    drop = PLIE_DROP_FRACTION * _body_height(joints)
+    drop = PLIE_DROP_FRACTION * body_height(joints)
     return np.where(flat, np.where(z < ref - drop, low, LEVELS.index("middle")), level)
 
 
@@ -794,7 +794,7 @@ def _support_cut_fn(
     return key
 
 
-def _body_height(joints: np.ndarray) -> float:
+def body_height(joints: np.ndarray) -> float:
     """Body height from the leg length (hip → ankle is 0.491 of the height at rest)."""
     leg = np.nanmedian(
         np.linalg.norm(joints[:, joint_index("right_hip")] - joints[:, joint_index("right_knee")], axis=-1)
