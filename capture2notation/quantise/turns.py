@@ -22,7 +22,7 @@ from fractions import Fraction
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..body import body_frame, front_of
+from ..body import body_frame, front_of, joint_index
 from ..notation.model import TURN_PART, TURN_STEP
 from .movement import Movement
 from .spans import movement_spans
@@ -35,6 +35,15 @@ EIGHTH_DEG = 360.0 * float(TURN_STEP)
 #: flip of the capture, not a turn: a fast pirouette (2 turns a second) turns
 #: 29° a frame at 25 fps, far below; a mirrored pair of hips jumps ~180°.
 FLIP_DEG = 120.0
+#: A measured change of front must reach this many eighths (34°) to be a
+#: turn: DESIGN.md's turn is at least an eighth, and a dancer's hips swing
+#: 20-30° either way in a casual dance without the front changing; the
+#: margin below 1 allows for the fit's ~10° error on a real eighth turn.
+MIN_MEASURED_EIGHTHS = 0.75
+#: A turn's feet turn too: one foot's heading changes by at least this
+#: fraction of the hips' change (a pivoting foot turns with the body; hips
+#: twisting over planted feet turn neither).
+FEET_TURN_FRACTION = 0.5
 #: Clean motion: a front this near (degrees) a multiple of an eighth may end
 #: one turn and start the next (numerical noise of the truth is ~1e-10°).
 _ON_EIGHTH_DEG = 0.05
@@ -141,11 +150,14 @@ def turn_movements(
         key.on_grid = on_grid is not None  # type: ignore[attr-defined]
         key.needs_minimum = lambda f: True  # type: ignore[attr-defined]
         spans = movement_spans(speed, _CLEAN_SPEED_DEG_S, _CLEAN_SPEED_DEG_S, 0.0, key_pose=key)
+    feet = _feet_heading(joints)
     out = []
     for a, b in spans:
         delta = float(front[b + 1] - front[a])
         eighths = int(round(delta / EIGHTH_DEG))
-        if eighths == 0:
+        if eighths == 0 or (measured and abs(delta) < MIN_MEASURED_EIGHTHS * EIGHTH_DEG):
+            continue
+        if not _feet_turn_too(feet, a, b + 1, delta):
             continue
         out.append(
             Movement(
@@ -160,6 +172,33 @@ def turn_movements(
             )
         )
     return out
+
+
+def _feet_heading(joints: np.ndarray) -> np.ndarray:
+    """(T, 2) each foot's heading (ankle → toe seen from above), degrees clockwise from +y, unwrapped."""
+    joints = np.asarray(joints, float)
+    out = np.full((joints.shape[0], 2), np.nan)
+    for k, side in enumerate(("right", "left")):
+        d = joints[:, joint_index(f"{side}_toe")] - joints[:, joint_index(f"{side}_ankle")]
+        a = np.arctan2(d[:, 0], d[:, 1])
+        ok = np.isfinite(a) & (np.hypot(d[:, 0], d[:, 1]) > 1e-6)
+        if ok.any():
+            t = np.arange(a.size)
+            out[:, k] = np.degrees(np.unwrap(np.interp(t, t[ok], a[ok])))
+    return out
+
+
+def _feet_turn_too(feet: np.ndarray, a: int, b: int, delta: float) -> bool:
+    """Whether a foot turns with the hips between frames a and b (by :data:`FEET_TURN_FRACTION` of `delta`).
+
+    A turn is the whole body's: the supporting foot pivots (or the feet turn
+    in the air).  Hips that twist over feet that stay put are a movement
+    of the pelvis, not a change of front.  Feet not measured: no veto.
+    """
+    d = feet[b] - feet[a]
+    if not np.isfinite(d).any():
+        return True
+    return bool(np.nanmax(np.sign(delta) * d) >= FEET_TURN_FRACTION * abs(delta))
 
 
 def turned_so_far(joints: np.ndarray, fps: float, measured: bool) -> np.ndarray:

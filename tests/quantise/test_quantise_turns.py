@@ -91,3 +91,46 @@ def test_written_turns_round_trip_on_two_feet():
     score = _turn_score([(0, 2, "right", "1/4"), (3, 2, "left", "3/8")], tempo=90)
     seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
     assert score_differences(score, seg.score) == []
+
+
+def test_kinect_body_key_reproduces_labanotationsuite_labels(fixture_path):
+    """LabanotationSuite's per-frame arm labels (an independent reference) from ``--axes body``."""
+    import json
+
+    from capture2notation.fitting.motion import joints_for_labels, read_motion
+    from capture2notation.notation.model import LEVELS
+    from capture2notation.quantise.labels import DIRECTION_NAMES, label_frames
+
+    motion = read_motion(fixture_path("kinect/joints.csv"))
+    ref = json.loads(fixture_path("kinect/joints.labanotationsuite_labels.json").read_text())["frames"]
+    ticks = np.array([r["timestamp"] for r in ref], float) * 1e-7
+    rows = [int(np.argmin(np.abs((motion.times - motion.times[0]) - (t - ticks[0])))) for t in ticks]
+    agree = {}
+    for axes in ("body", "standard"):
+        lab = label_frames(joints_for_labels(motion), motion.fps, axes=axes)
+        same = []
+        for r, f in zip(ref, rows):
+            for side in ("right", "left"):
+                for seg, part in (("elbow", "upper_arm"), ("wrist", "forearm")):
+                    p = lab.index(f"{side}_{part}")
+                    d, lv = r[f"{side} {seg}"]
+                    theirs = (
+                        d.lower().replace(" ", "").replace("backward", "back"),
+                        lv.lower().replace("normal", "middle"),
+                    )
+                    same.append(
+                        (DIRECTION_NAMES[lab.direction[f, p]].replace("_", ""), LEVELS[lab.level[f, p]]) == theirs
+                    )
+        agree[axes] = float(np.mean(same))
+    assert agree["body"] >= 0.97
+    # The standard key reads the arms against gravity, not the leaning torso.
+    assert agree["standard"] < 0.9
+
+
+def test_turn_and_jump_phrase_captures_exactly_with_estimated_tempo():
+    import synthetic.phrases as phrases
+
+    score = phrases.phrase("turn_and_jump")
+    seg = segment_motion(interpret(score, fps=FPS).joints(), FPS)
+    assert seg.tempo == score.tempo
+    assert score_differences(score, seg.score) == []
