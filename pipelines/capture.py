@@ -270,7 +270,10 @@ def capture(
     kind = input_kind(input_path)
     outdir = Path(outdir)
     motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress, flip_test)
-    joints = np.asarray(motion.joints, dtype=float) if kind == "video" else joints_for_labels(motion)
+    # The body key is LabanotationSuite's reading of a Kinect's own arm
+    # positions; the standard key keeps the fit throughout.
+    measured_arms = kind != "video" and axes == "body"
+    joints = joints_for_labels(motion) if measured_arms else np.asarray(motion.joints, dtype=float)
     fps = float(motion.fps)
     if not np.isfinite(joints).any():
         raise PipelineError(f"{input_path}: no frame could be measured (no person found?)")

@@ -54,12 +54,12 @@ class MotionData(FitResult):
 
 
 #: Joints whose measured positions (Kinect) are read instead of the fit's:
-#: the trunk's body cross and the arms.  Legs and feet keep the fit (its
-#: floor, foot pitch and bone lengths are what the supports are read from).
+#: the body cross (shoulders, mid-spine) and the arms.  Legs and feet keep
+#: the fit (its floor, foot pitch and bone lengths are what the supports are
+#: read from), and so does the head (the sensor's Head point sits at the
+#: skull's centre, not where our head joint is).
 MEASURED_FOR_LABELS = (
     "waist",
-    "neck",
-    "head",
     "right_shoulder",
     "left_shoulder",
     "right_elbow",
