@@ -142,7 +142,7 @@ def render_pose(
         for i in frames:
             writer.write(renderer.frame(i))
     write_truth(outdir / "truth.npz", **fields)
-    write_camera_toml(camera, outdir / CAMERA_FILE, name=camera_name(video))
+    write_camera_toml(camera, outdir / CAMERA_FILE, name=camera_name(outdir.resolve()))
     return video
 
 
