@@ -28,6 +28,8 @@ are returned as NaN with zero confidence rather than invented.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..body import JOINTS, Body, joint_index
@@ -51,7 +53,7 @@ from .solver import (
     to_result,
 )
 from .temporal import coupled_params, smooth_root
-from .uncertainty import direction_spread, spread_factor
+from .uncertainty import direction_spread, spread_factor, with_identity_confidence
 
 __all__ = ["TARGETS_2D", "fit_keypoints", "fit_track", "refine_focal"]
 
@@ -845,7 +847,7 @@ def fit_track(
         # BlazePose's world landmarks give a straight hanging limb a depth
         # of its own (:mod:`~capture2notation.fitting.depth`).
         options = FitOptions(depth=DepthOptions(rest_offset=True))
-    return fit_keypoints(
+    result = fit_keypoints(
         xy,
         vis,
         float(track.fps),
@@ -856,3 +858,7 @@ def fit_track(
         image_size=tuple(np.asarray(track.image_size).tolist()),
         options=options,
     )
+    ident = getattr(track, "identity_confidence", None)
+    if ident is None or not np.any(np.isfinite(ident)):
+        return result
+    return replace(result, confidence=with_identity_confidence(result.confidence, ident))

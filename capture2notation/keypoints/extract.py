@@ -44,6 +44,7 @@ def extract_frames(
     estimator=None,
     progress=None,
     flip_test: bool | None = None,
+    identity: bool = True,
 ) -> KeypointTrack:
     """Keypoints of a stream of frames.
 
@@ -72,6 +73,10 @@ def extract_frames(
         BlazePose only: also read the mirrored crop and average (more
         accurate, twice the inference cost).  Default: off for a new
         estimator, unchanged for a given one.
+    identity : bool
+        BlazePose only: decide left/right and front/back over the whole clip
+        and correct the track (:func:`~.identity.correct_identity`), which
+        sets ``identity_confidence``; otherwise it is NaN (not assessed).
 
     Returns
     -------
@@ -118,7 +123,7 @@ def extract_frames(
             progress(frame.index)
     if size is None:
         raise KeypointError("no frames to extract keypoints from")
-    return KeypointTrack(
+    track = KeypointTrack(
         fps=fps,
         times=np.array(times),
         image_size=np.array(size),
@@ -129,6 +134,11 @@ def extract_frames(
         crops=np.array(crops),
         backend=est.backend,
     )
+    if identity and track.backend == "blazepose":
+        from .identity import correct_identity
+
+        track, _ = correct_identity(track)
+    return track
 
 
 def extract(
@@ -145,6 +155,7 @@ def extract(
     estimator=None,
     progress: bool = False,
     flip_test: bool | None = None,
+    identity: bool = True,
 ) -> KeypointTrack:
     """Keypoints of a video file or image folder.
 
@@ -159,7 +170,7 @@ def extract(
         Frame rate of an image folder (default 30) or override for a file.
     start, stop : int
         Frame range ``[start, stop)``.
-    threads, smooth, markers, estimator, flip_test
+    threads, smooth, markers, estimator, flip_test, identity
         As :func:`extract_frames`.
     progress : bool
         Show progress on stderr (a bar on a terminal, else a line every 30 s).
@@ -173,7 +184,7 @@ def extract(
     if not progress:
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
-            markers=markers, estimator=estimator, flip_test=flip_test,
+            markers=markers, estimator=estimator, flip_test=flip_test, identity=identity,
         )  # fmt: skip
     from ..progress import progress as progress_bar
 
@@ -182,4 +193,5 @@ def extract(
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, progress=lambda _i: bar.update(1), flip_test=flip_test,
+            identity=identity,
         )  # fmt: skip

@@ -66,6 +66,11 @@ class KeypointTrack:
         and rotation (radians, clockwise in the image); NaN when unused.
     backend : str
         ``"blazepose"`` or ``"markers"``.
+    identity_confidence : (T,) ndarray
+        Probability in [0, 1] that the frame's left/right labels are right
+        (:func:`~capture2notation.keypoints.identity.correct_identity`); NaN
+        where not assessed, 0 where no person was seen.  Optional in the
+        ``.npz`` (older tracks read as NaN).
     """
 
     fps: float
@@ -78,6 +83,7 @@ class KeypointTrack:
     crops: np.ndarray
     backend: str = "blazepose"
     names: tuple[str, ...] = field(default=LANDMARK_NAMES, repr=False)
+    identity_confidence: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.fps = float(self.fps)
@@ -89,6 +95,9 @@ class KeypointTrack:
         self.world = np.asarray(self.world, dtype=float)
         self.crops = np.asarray(self.crops, dtype=float)
         self.backend = str(self.backend)
+        n = self.times.shape[0] if self.times.ndim == 1 else 0
+        ident = np.full(n, np.nan) if self.identity_confidence is None else self.identity_confidence
+        self.identity_confidence = np.asarray(ident, dtype=float)
         self.validate()
 
     def validate(self) -> None:
@@ -103,6 +112,7 @@ class KeypointTrack:
             "presence": (t,),
             "world": (t, k, 3),
             "crops": (t, 5),
+            "identity_confidence": (t,),
         }
         for name, shape in expected.items():
             got = getattr(self, name).shape
@@ -113,6 +123,9 @@ class KeypointTrack:
         vis = self.visibility[np.isfinite(self.visibility)]
         if vis.size and (vis.min() < 0 or vis.max() > 1):
             raise KeypointError(f"keypoint track visibility outside [0, 1]: [{vis.min()}, {vis.max()}]")
+        ident = self.identity_confidence[np.isfinite(self.identity_confidence)]
+        if ident.size and (ident.min() < 0 or ident.max() > 1):
+            raise KeypointError(f"keypoint track identity_confidence outside [0, 1]: [{ident.min()}, {ident.max()}]")
 
     def __len__(self) -> int:
         return int(self.times.shape[0])
@@ -140,6 +153,7 @@ class KeypointTrack:
         arrays = {name: getattr(self, name) for name in _FIELDS}
         arrays["backend"] = np.array(self.backend)
         arrays["names"] = np.array(self.names)
+        arrays["identity_confidence"] = self.identity_confidence
         with (
             atomic_path(path, suffix=".npz") as tmp,
             open(tmp, "wb") as f,
@@ -164,6 +178,8 @@ class KeypointTrack:
                     raise KeypointError(f"{path}: not a keypoint track, missing fields {missing}")
                 values = {f: data[f] for f in _FIELDS}
                 names = tuple(str(n) for n in data["names"]) if "names" in data.files else LANDMARK_NAMES
+                if "identity_confidence" in data.files:
+                    values["identity_confidence"] = data["identity_confidence"]
         except (OSError, ValueError) as exc:
             raise KeypointError(f"{path}: cannot read keypoint track: {exc}") from exc
         values["fps"] = float(values["fps"])

@@ -39,6 +39,7 @@ __all__ = [
     "PART_MIDDLE_JOINT",
     "PART_SEGMENTS",
     "SUPPORT_PARTS",
+    "SYMBOL_UNCERTAIN_BELOW",
     "TURN_DIRECTIONS",
     "TURN_PART",
     "TURN_STEP",
@@ -111,6 +112,9 @@ DIRECTIONS: MappingProxyType = MappingProxyType(
 )
 LEVELS: tuple[str, ...] = ("high", "middle", "low")
 MAX_BEND = 6
+#: A symbol whose confidence is below this is uncertain: drawn grey and
+#: hatched on the staff and listed as such (a coin toss between readings).
+SYMBOL_UNCERTAIN_BELOW = 0.5
 
 
 def as_fraction(value, what: str = "value") -> Fraction:
@@ -210,6 +214,11 @@ class Symbol:
     amount : Fraction or None
         Full turns of a turn symbol (a positive multiple of 1/8, at most
         :data:`~.limits.MAX_TURN`); None for every other symbol.
+    confidence : float or None
+        How sure a capture is of this symbol, in [0, 1] (keypoint visibility
+        and left/right identity, the fit's confidence, the angle's distance
+        from a sector or level boundary); None for written scores (not
+        assessed).  Metadata: symbols equal in everything else are equal.
     """
 
     start: Fraction
@@ -219,8 +228,10 @@ class Symbol:
     level: str | None
     bend: int = 0
     amount: Fraction | None = None
+    confidence: float | None = field(default=None, compare=False)
 
     def __post_init__(self):
+        self._check_confidence()
         object.__setattr__(self, "start", as_fraction(self.start, "start"))
         object.__setattr__(self, "duration", as_fraction(self.duration, "duration"))
         if self.start < 0:
@@ -257,6 +268,19 @@ class Symbol:
             raise NotationError(
                 f"bend={self.bend} is only allowed on {', '.join(sorted(BENDABLE_PARTS))}, not {self.part}"
             )
+
+    def _check_confidence(self) -> None:
+        c = self.confidence
+        if c is None:
+            return
+        if isinstance(c, bool) or not isinstance(c, (int, float)) or not (0.0 <= float(c) <= 1.0):
+            raise NotationError(f"confidence {c!r} must be a number in [0, 1] (or absent)")
+        object.__setattr__(self, "confidence", float(c))
+
+    @property
+    def uncertain(self) -> bool:
+        """The capture was not sure of this symbol (:data:`SYMBOL_UNCERTAIN_BELOW`)."""
+        return self.confidence is not None and self.confidence < SYMBOL_UNCERTAIN_BELOW
 
     def _check_turn(self) -> None:
         if self.direction not in TURN_DIRECTIONS:

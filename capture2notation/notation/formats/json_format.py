@@ -17,7 +17,8 @@
 Beats (``start``, ``duration``) are written as exact ``"p/q"`` strings; the
 tempo as an integer when whole, else ``"p/q"``.  The reader also accepts
 integers and exactly representable floats (0.5) for beats and tempo, and
-``bend`` may be omitted (0).  ``format``/``version`` are written for
+``bend`` may be omitted (0).  A captured symbol carries its
+``confidence`` in [0, 1] (optional; absent or null: not assessed).  ``format``/``version`` are written for
 identification and checked only if present (versions 1 and 2 are read;
 version 1 has no turns, flight or ``axes``).  A turn's ``amount`` is full
 turns as ``"p/q"``; a flight's ``spring`` is its spring form
@@ -49,7 +50,9 @@ FORMAT_TAG = "capture2notation.score"
 VERSION = 2
 _READ_VERSIONS = (1, 2)
 _TOP_KEYS = frozenset({"format", "version", "title", "tempo", "meter", "effort", "emotion", "axes", "symbols"})
-_SYMBOL_KEYS = ("start", "duration", "part", "direction", "level", "bend", "amount", "spring")
+_SYMBOL_KEYS = ("start", "duration", "part", "direction", "level", "bend", "amount", "spring", "confidence")
+#: Decimals of a written confidence (a probability; more is noise).
+CONFIDENCE_DECIMALS = 3
 _REQUIRED_KEYS = ("start", "duration", "part", "direction")
 
 
@@ -87,6 +90,8 @@ def _symbol_dict(forms: dict, s: Symbol) -> dict:
         out["amount"] = format_fraction(s.amount)
     if s.is_air:
         out["spring"] = forms[s.start]
+    if s.confidence is not None:
+        out["confidence"] = round(s.confidence, CONFIDENCE_DECIMALS)
     return out
 
 
@@ -138,8 +143,16 @@ def _symbol(item, jpath: str, where: _Where) -> Symbol:
     amount = None
     if item.get("amount") is not None:
         amount = _fraction(item["amount"], f"{jpath}.amount", where)
+    confidence = item.get("confidence")
+    if confidence is not None and (
+        isinstance(confidence, bool)
+        or not isinstance(confidence, (int, float))
+        or not math.isfinite(confidence)
+        or not 0 <= confidence <= 1
+    ):
+        where.fail(f"{jpath}.confidence", f"expected a number in [0, 1] or null, got {_show(confidence)}")
     try:
-        return Symbol(start, duration, item["part"], item["direction"], level, bend, amount)
+        return Symbol(start, duration, item["part"], item["direction"], level, bend, amount, confidence)
     except NotationError as exc:
         # Point at the field the model complained about when it is clear.
         msg = str(exc)

@@ -44,6 +44,10 @@ segment is then classified with the shared thresholds
 (:func:`~capture2notation.notation.directions.classify`).  With bend 0 both
 segments take the arm's direction and level.
 
+A captured symbol's confidence is written in the position where it
+arrives, ``"confidence": {"right elbow": "0.412", ...}`` (a whole arm's on
+both of its fields); files without it read as not assessed.
+
 Reading
 -------
 Positions become symbols of ``right_upper_arm``, ``right_forearm``,
@@ -76,6 +80,7 @@ from ..model import TURN_PART, TURN_STEP, Score, Symbol
 from .json_format import load_json
 
 __all__ = [
+    "CONFIDENCE_KEY",
     "DIRECTION_NAMES",
     "LEVEL_NAMES",
     "arm_segments",
@@ -103,6 +108,9 @@ _DIRECTION_BACK = {v: k for k, v in DIRECTION_NAMES.items()}
 _LEVEL_BACK = {v: k for k, v in LEVEL_NAMES.items()}
 
 #: Suite field → (our segment part, whole-limb part, segment role).
+#: A position's optional object of the confidence (``"0.812"``) of each
+#: field whose symbol arrives there; the suite ignores keys it does not know.
+CONFIDENCE_KEY = "confidence"
 _FIELDS = (
     ("head", "head", None, None),
     ("right elbow", "right_upper_arm", "right_arm", 0),
@@ -180,21 +188,31 @@ def score_to_laban_editor(score: Score, name: str | None = None) -> dict:
     k = 0
     prev_ms = 0
     for t in times:
+        arrived: dict[str, float] = {}  # segment -> confidence of the symbol arriving here
         while k < len(events) and events[k].end <= t:
             s = events[k]
             if s.part in ("right_arm", "left_arm"):
                 side = s.part.split("_")[0]
                 upper, fore = arm_segments(s.part, s.direction, s.level, s.bend)
                 state[f"{side}_upper_arm"], state[f"{side}_forearm"] = upper, fore
+                segments = [f"{side}_upper_arm", f"{side}_forearm"]
             else:
                 state[s.part] = (s.direction, s.level)
+                segments = [s.part]
+            for seg in segments:
+                arrived.pop(seg, None)
+                if s.confidence is not None:
+                    arrived[seg] = s.confidence
             k += 1
         ms = _ms(t, score.tempo)
-        pose = {"start time": [str(ms)], "duration": [str(ms - prev_ms)]}
+        pose: dict[str, object] = {"start time": [str(ms)], "duration": [str(ms - prev_ms)]}
         for field, part, _, _ in _FIELDS:
             d, lv = state[part]
             pose[field] = [DIRECTION_NAMES[d], LEVEL_NAMES[lv]]
         pose["rotation"] = _rotation(front_at(t))
+        conf = {field: f"{arrived[part]:.3f}" for field, part, _, _ in _FIELDS if part in arrived}
+        if conf:
+            pose[CONFIDENCE_KEY] = conf
         positions[f"Position{len(positions)}"] = pose
         prev_ms = ms
     return {name or score.title or "score": positions}
@@ -268,6 +286,25 @@ def _front_eighths(value, where: str, path) -> int:
     return round(_ROTATION_WORDS[word] * deg / float(360 * TURN_STEP))
 
 
+def _confidences(value, where: str, path) -> dict[str, float]:
+    """Segment → confidence from a position's ``confidence`` object (see the module docstring)."""
+    by_field = {field: part for field, part, _, _ in _FIELDS}
+    if not isinstance(value, dict):
+        raise ScoreFormatError(f'{where}: expected {{field: "0.xyz"}}, got {_show(value)}', path)
+    out = {}
+    for field, text in value.items():
+        if field not in by_field:
+            raise ScoreFormatError(
+                f"{where}: unknown field {_show(field)}; expected one of {', '.join(by_field)}", path
+            )
+        ok = isinstance(text, str) and len(text) <= MAX_NUMBER_CHARS and re.fullmatch(r"[0-9]*\.?[0-9]+", text)
+        c = float(text) if ok else math.nan
+        if not 0.0 <= c <= 1.0:
+            raise ScoreFormatError(f"{where}.{field}: expected a number in [0, 1] as a string, got {_show(text)}", path)
+        out[by_field[field]] = c
+    return out
+
+
 def _show(value) -> str:
     try:
         text = json.dumps(value, ensure_ascii=False)
@@ -305,13 +342,14 @@ def loads(text: str, path: str | None = None) -> Score:
             if field in pose:
                 state[part] = _pair(pose[field], f"{where}.{field}", path)
         front = _front_eighths(pose["rotation"], f"{where}.rotation", path) if "rotation" in pose else None
-        poses.append((ms, where, state, front))
+        conf = _confidences(pose[CONFIDENCE_KEY], f"{where}.{CONFIDENCE_KEY}", path) if CONFIDENCE_KEY in pose else {}
+        poses.append((ms, where, state, front, conf))
     poses.sort(key=lambda p: p[0])
     symbols = []
     prev_ms, current = 0, dict(_START)
     front0 = next((p[3] for p in poses if p[3] is not None), 0)
     current_front = front0
-    for ms, where, state, front in poses:
+    for ms, where, state, front, conf in poses:
         changes: list[tuple[str, tuple[str, str] | int]] = [
             (part, target) for part, target in state.items() if target != current[part]
         ]
@@ -330,7 +368,7 @@ def loads(text: str, path: str | None = None) -> Score:
                     symbols.append(Symbol(start, dur, TURN_PART, direction, None, amount=abs(delta)))
                     current_front = target
                 else:
-                    symbols.append(Symbol(start, dur, part, *target))
+                    symbols.append(Symbol(start, dur, part, *target, confidence=conf.get(part)))
                     current[part] = target
             except NotationError as exc:
                 raise ScoreFormatError(f"{where}: {exc}", path) from None

@@ -1,0 +1,146 @@
+"""Left/right and front/back identity: the whole-clip decoder on the virtual dancer.
+
+Random scores with turns (``random_score(..., turns=True)``) performed by
+the virtual dancer; the truth keypoints of a front camera are turned into a
+BlazePose-like track (:func:`synthetic.identity_errors.truth_track`) with the
+pose model's errors put in: one long stretch (25-45 % of the clip) read with
+left and right exchanged and every back view read as a front view.  Prints,
+before and after :func:`capture2notation.keypoints.identity.correct_identity`,
+the frames with the right identity, the frames whose facing is right, the
+facing flips away from side views, and the frames marked uncertain.
+
+Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S]``
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from capture2notation.body import Body
+from capture2notation.keypoints.identity import correct_identity
+from synthetic.identity_errors import facing_camera, truth_track, with_identity_errors
+from synthetic.interpret import interpret
+from synthetic.random_scores import random_score
+from synthetic.render.camera import Camera
+from synthetic.render.job import truth_fields
+from synthetic.render.scene import Pose
+
+#: Frames this close to side-on (degrees) are not scored for facing: there
+#: the facing is undefined to within the noise.
+SIDE_BAND_DEG = 15.0
+
+
+def clip(seed: int, n_beats: int = 24, fps: float = 25.0, clean: bool = False):
+    rng = np.random.default_rng(seed)
+    score = random_score(rng, n_beats=n_beats, turns=True, fps=fps)
+    pose = Pose.from_motion(interpret(score, fps, Body()))
+    camera = Camera.for_view("front", (640, 480), pose.body.height)
+    fields = truth_fields(pose, camera)
+    track = truth_track(fields)
+    facing = facing_camera(fields["front"], camera.R)
+    dur = track.times[-1]
+    length = rng.uniform(0.25, 0.45) * dur
+    start = rng.uniform(0.05 * dur, 0.95 * dur - length)
+    swaps = () if clean else ((start, start + length),)
+    bad, sim = with_identity_errors(track, facing, rng, swaps=swaps, back_as_front=not clean)
+    # Angle from side-on of the body's front, to leave the side views out of the facing score.
+    a = np.radians(fields["front"])
+    fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ camera.R.T
+    off_side = np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
+    return bad, sim, off_side
+
+
+def flips(facing: np.ndarray, keep: np.ndarray) -> int:
+    f = facing[keep]
+    return int(np.sum(f[1:] != f[:-1]))
+
+
+def rendered(seed: int, outdir, n_beats: int = 16) -> None:
+    """A render of a random score with turns through BlazePose: identity before and after the decoder."""
+    from pathlib import Path
+
+    from capture2notation.io.truth import read_truth
+    from capture2notation.keypoints import extract
+    from capture2notation.keypoints.evaluate import left_right_swaps, person_height_px
+    from capture2notation.keypoints.identity import decode_identity
+    from synthetic.render.job import render_score
+
+    for s in range(seed, seed + 40):  # the first draw that turns its back to the camera
+        score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
+        pose = Pose.from_motion(interpret(score, 25.0, Body()))
+        camera = Camera.for_view("front", (640, 480), pose.body.height)
+        fields = truth_fields(pose, camera)
+        facing = facing_camera(fields["front"], camera.R)
+        if (~facing).sum() >= 20:
+            break
+    out = render_score(score, Path(outdir) / f"r{s}", progress=False)
+    truth = read_truth(out / "truth.npz")
+    raw = extract(out / "video.mp4", identity=False)
+    fixed = extract(out / "video.mp4")
+    radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
+    truth_face = np.where(facing, 1, -1)
+    for name, tr in (("as read", raw), ("decoded", fixed)):
+        sw = np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0)
+        print(
+            f"render seed {s} ({len(tr)} frames, {int((~facing).sum())} back to camera) {name}: right identity {1 - sw.mean():.1%}"
+        )
+    res = decode_identity(raw)
+    a = np.radians(fields["front"])
+    fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ camera.R.T
+    off = np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
+    print(
+        f"render seed {s}: decoded facing right {np.mean((res.facing == truth_face)[off]):.1%} off side views; "
+        f"flips truth {flips(truth_face, off)} decoded {flips(res.facing, off)}; uncertain {res.uncertain.mean():.1%}"
+    )
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--clips", type=int, default=6)
+    ap.add_argument("--seed", type=int, default=1600)
+    ap.add_argument("--render", metavar="DIR", help="also render one turning clip into DIR and run BlazePose on it")
+    ap.add_argument("--clean", action="store_true", help="no errors put in (false corrections)")
+    args = ap.parse_args(argv)
+    if args.render:
+        rendered(args.seed, args.render)
+    tot = {"n": 0, "before": 0, "after": 0, "face_before": 0, "face_after": 0, "nf": 0, "unc": 0, "unc_wrong": 0}
+    for i in range(args.clips):
+        seed = args.seed + i
+        bad, sim, off_side = clip(seed, clean=args.clean)
+        _, res = correct_identity(bad)
+        right_before = ~sim.swapped
+        right_after = res.swapped == sim.swapped
+        truth_face = np.where(sim.facing, 1, -1)
+        naive_face = np.where(np.sign(np.nan_to_num(bad.xy[:, 11, 0] - bad.xy[:, 12, 0])) >= 0, 1, -1)
+        face_before = (naive_face == truth_face)[off_side]
+        face_after = (res.facing == truth_face)[off_side]
+        n_back = int((~sim.facing).sum())
+        print(
+            f"seed {seed}: {len(bad)} frames, {n_back} back to camera, {int(sim.swapped.sum())} swapped; "
+            f"right identity {right_before.mean():.1%} -> {right_after.mean():.1%}; "
+            f"facing right {face_before.mean():.1%} -> {face_after.mean():.1%}; "
+            f"facing flips truth {flips(truth_face, off_side)} decoded {flips(res.facing, off_side)}; "
+            f"uncertain {res.uncertain.mean():.1%}"
+        )
+        tot["n"] += len(bad)
+        tot["before"] += int(right_before.sum())
+        tot["after"] += int(right_after.sum())
+        tot["nf"] += int(off_side.sum())
+        tot["face_before"] += int(face_before.sum())
+        tot["face_after"] += int(face_after.sum())
+        tot["unc"] += int(res.uncertain.sum())
+        tot["unc_wrong"] += int((res.uncertain & ~right_after).sum())
+    n = tot["n"]
+    if not n:
+        return
+    print(
+        f"ALL {args.clips} clips, {n} frames: right identity {tot['before'] / n:.2%} -> {tot['after'] / n:.2%}; "
+        f"facing right (off side views) {tot['face_before'] / tot['nf']:.2%} -> {tot['face_after'] / tot['nf']:.2%}; "
+        f"uncertain {tot['unc'] / n:.2%} (of them wrong {tot['unc_wrong']}/{tot['unc']})"
+    )
+
+
+if __name__ == "__main__":
+    main()
