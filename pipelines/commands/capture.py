@@ -55,7 +55,15 @@ __all__ = ["capture"]
     help="Cross of axes limb directions are read in: 'standard' (vertical from gravity, front from the hips) "
     "or 'body' (arms and head along the torso, as LabanotationSuite reads Kinect captures).",
 )
-def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes):
+@click.option(
+    "--calibration",
+    type=click.Path(dir_okay=False, path_type=str),
+    default=None,
+    metavar="FILE",
+    help="A calibration file (TOML, as written by c2n render's camera.toml) with the video's camera; "
+    "by default the camera is estimated from the person.",
+)
+def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes, calibration):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
     into notation files in OUTDIR."""
     from fractions import Fraction
@@ -85,6 +93,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         seed=seed,
         flip_test=flip_test,
         axes=axes,
+        calibration=calibration,
     )
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
