@@ -47,7 +47,15 @@ __all__ = ["capture"]
     is_flag=True,
     help="BlazePose also reads a mirrored copy of each crop (more accurate in side views; slower).",
 )
-def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test):
+@click.option(
+    "--calibration",
+    type=click.Path(dir_okay=False, path_type=str),
+    default=None,
+    metavar="FILE",
+    help="A calibration file (TOML, as written by c2n render's camera.toml) with the video's camera; "
+    "by default the camera is estimated from the person.",
+)
+def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, calibration):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
     into notation files in OUTDIR."""
     from fractions import Fraction
@@ -76,6 +84,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         effort=not no_effort,
         seed=seed,
         flip_test=flip_test,
+        calibration=calibration,
     )
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
