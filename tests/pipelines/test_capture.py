@@ -397,6 +397,9 @@ def test_one_movement_is_no_beat_and_says_so(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings(
+    "ignore:feet on the floor in only"
+)  # these clips' floor is not found; beside the point here
 @pytest.mark.parametrize("rel", ["mediapipe/pose_squats.mp4", "bvh/jesse_dance.bvh", "bvh/test_mocapbank.bvh"])
 def test_emotion_not_read_outside_the_port_de_bras(rel, fixture_path, tmp_path):
     """A squat video and the fixture BVH dances are no port de bras: the emotion is not read, with reasons."""
