@@ -13,7 +13,9 @@ written atomically into OUTDIR:
 ``labels.csv``      per-frame labels of every part
 ``staff.svg/.png``  the Labanotation staff
 ``capture.npz``     keypoints (video input), fitted joints (T, J, 3), angles,
-                    confidence (T, J), fps, times
+                    confidence (T, J), fps, times; for video the camera
+                    estimate with its uncertainty (``camera_estimate``,
+                    JSON) and which camera the fit used (``camera_source``)
 ``effort.json``     Laban Effort with uncertainty (and its plots)
 ``overlay.mp4``     the video with the keypoints drawn (video input)
 ``index.html``      the staff beside the overlay video
@@ -101,6 +103,11 @@ class CaptureResult:
         Outputs not written, with the reason.
     tempo_text : str
         How the tempo was set, after "tempo N bpm" (:func:`tempo_note`).
+    camera_estimate : CameraEstimate or None
+        The camera estimated from the person (video input; None when the
+        feet and body were not seen in enough frames).
+    camera_source : str
+        ``"estimated"`` or ``"calibration FILE"``: the camera the fit used.
     """
 
     outdir: Path
@@ -113,6 +120,8 @@ class CaptureResult:
     seconds: dict = field(default_factory=dict)
     skipped: tuple = ()
     tempo_text: str = ""
+    camera_estimate: object | None = None
+    camera_source: str = ""
 
     @property
     def n_frames(self) -> int:
@@ -294,6 +303,19 @@ def capture(
     motion, track, seconds = load_motion(
         input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration
     )
+    estimate, camera_source = None, ""
+    if track is not None:
+        from capture2notation.fitting.camera_estimate import estimate_camera
+
+        t0 = time.perf_counter()
+        try:
+            estimate = estimate_camera(track.xy, track.visibility, track.world, track.image_size, seed=seed)
+        except (C2NError, ValueError, np.linalg.LinAlgError) as exc:
+            # The estimate is a report beside the fit: say so and go on.
+            log.warning("capture: camera not estimated: %s", exc)
+        seconds["camera"] = time.perf_counter() - t0
+        camera_source = "estimated" if calibration is None else f"calibration {calibration}"
+        log.info("capture: %s", estimate.line() if estimate is not None else "camera not estimated (feet unseen)")
     # The body key is LabanotationSuite's reading of a Kinect's own arm
     # positions; the standard key keeps the fit throughout.
     measured_arms = kind != "video" and axes == "body"
@@ -329,7 +351,7 @@ def capture(
     how = tempo_note(seg, sound)
     log.info("capture: tempo %s bpm%s", seg.tempo, how)
     with _staging(outdir) as stage:
-        files, skipped = _write_outputs(stage, seg, motion, track, input_path, kind, overlay)
+        files, skipped = _write_outputs(stage, seg, motion, track, input_path, kind, overlay, (estimate, camera_source))
         if effort:
             t0 = time.perf_counter()
             try:
@@ -339,7 +361,9 @@ def capture(
                 skipped.append(f"effort.json: {exc}")
                 log.warning("capture: effort not estimated: %s", exc)
             seconds["effort"] = time.perf_counter() - t0
-        staged = CaptureResult(outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped), how)
+        staged = CaptureResult(
+            outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped), how, estimate, camera_source
+        )
         files["index.html"] = write_text(stage / "index.html", index_html(staged))
         files = {name: outdir / Path(p).relative_to(stage) for name, p in files.items()}
     return replace(staged, files=files)
@@ -372,7 +396,9 @@ def _staging(outdir: Path):
         shutil.rmtree(stage, ignore_errors=True)
 
 
-def _write_outputs(outdir: Path, seg: Segmentation, motion, track, input_path, kind: str, overlay: bool):
+def _write_outputs(
+    outdir: Path, seg: Segmentation, motion, track, input_path, kind: str, overlay: bool, camera=(None, "")
+):
     from capture2notation.notation import write
     from capture2notation.notation.formats.laban_editor import write_laban_editor
     from capture2notation.notation.staff import render_staff
@@ -391,7 +417,7 @@ def _write_outputs(outdir: Path, seg: Segmentation, motion, track, input_path, k
     files["labels.csv"] = outdir / "labels.csv"
     files["staff.svg"] = render_staff(score, outdir / "staff.svg", outdir / "staff.png")
     files["staff.png"] = outdir / "staff.png"
-    files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track)
+    files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track, *camera)
     if kind == "video" and overlay and track is not None:
         from capture2notation.keypoints.overlay import write_overlay
 
@@ -401,7 +427,7 @@ def _write_outputs(outdir: Path, seg: Segmentation, motion, track, input_path, k
     return files, skipped
 
 
-def _write_npz(path: Path, motion, track) -> Path:
+def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = "") -> Path:
     T = np.asarray(motion.joints).shape[0]
     arrays = {
         "fps": np.asarray(float(motion.fps)),
@@ -416,6 +442,9 @@ def _write_npz(path: Path, motion, track) -> Path:
         arrays["keypoints"] = np.asarray(track.xy, float)
         arrays["visibility"] = np.asarray(track.visibility, float)
         arrays["image_size"] = np.asarray(track.image_size)
+        # JSON text (no pickles): the estimate and its 1-sd uncertainties.
+        arrays["camera_estimate"] = np.asarray(json.dumps(None if estimate is None else estimate.as_dict()))
+        arrays["camera_source"] = np.asarray(camera_source)
     else:
         arrays["keypoints"] = np.full((T, 33, 3), np.nan)
         arrays["visibility"] = np.zeros((T, 33))
@@ -562,6 +591,16 @@ def index_html(result: CaptureResult) -> str:
     skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
     timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
     effort = _effort_html(result.files)
+    camera = ""
+    if result.track is not None:
+        est = result.camera_estimate
+        said = est.line() if est is not None else "camera not estimated: the feet and body were seen in too few frames"
+        used = (
+            "the fit used the camera of the " + result.camera_source
+            if result.camera_source.startswith("calibration")
+            else "the fit estimated its own camera (no calibration given)"
+        )
+        camera = f"<p>{html.escape(said)}; {html.escape(used)}.</p>"
     return f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>Capture: {html.escape(score.title)}</title>
 <style>
@@ -574,6 +613,7 @@ table {{ border-collapse: collapse; }} td, th {{ padding: 0.1em 0.6em; border-bo
 <h1>Capture: {html.escape(score.title)}</h1>
 <p>{result.n_frames} frames at {float(result.motion.fps):g} fps · input: {html.escape(result.kind)} ·
 tempo {html.escape(tempo)} · meter {score.meter} · {len(score.symbols)} symbols</p>
+{camera}
 <div class="row">
 <div class="staff"><img src="staff.svg" alt="Labanotation staff of the captured score"></div>
 <div class="video">{video}

@@ -99,6 +99,8 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "
         f"({result.kind}), tempo {result.score.tempo} bpm{result.tempo_text}"
     )
+    if result.camera_estimate is not None:
+        click.echo(f"  {result.camera_estimate.line()}")
     if "effort.json" in result.files:
         data = json.loads(Path(result.files["effort.json"]).read_text(encoding="utf-8"))
         click.echo(f"  emotion: {emotion_line(data)}")

@@ -40,6 +40,36 @@ def _fps(value: float) -> float:
     return value
 
 
+#: Camera settings ``c2n render`` accepts: (option, low, high, unit) — the
+#: phones people film dance with, on a tripod or a table (issue 13).
+CAMERA_RANGES = {
+    "camera_height": ("--camera-height", 0.4, 2.0, "m"),
+    "pitch": ("--pitch", -20.0, 20.0, "°"),
+    "roll": ("--roll", -10.0, 10.0, "°"),
+    "hfov": ("--hfov", 50.0, 80.0, "°"),
+}
+
+
+def _phone_camera(view, size, camera_height, pitch, roll, hfov):
+    """The render camera for the camera options (None: the view's preset)."""
+    given = {"camera_height": camera_height, "pitch": pitch, "roll": roll, "hfov": hfov}
+    if all(v is None for v in given.values()):
+        return None
+    for key, value in given.items():
+        option, lo, hi, unit = CAMERA_RANGES[key]
+        if value is not None and not (lo <= value <= hi):
+            raise PipelineError(f"{option} {value:g} must be in [{lo:g}, {hi:g}] {unit}")
+    from capture2notation.errors import SyntheticError
+    from synthetic.render.camera import Camera
+
+    try:
+        return Camera.phone(
+            view, size, height=camera_height, pitch_deg=pitch or 0.0, roll_deg=roll or 0.0, hfov_deg=hfov
+        )
+    except SyntheticError as exc:
+        raise PipelineError(f"--camera-height/--pitch/--hfov: {exc}") from None
+
+
 @click.command("render")
 @click.argument("score", type=click.Path(dir_okay=False, path_type=str))
 @click.option(
@@ -63,7 +93,11 @@ def _fps(value: float) -> float:
     help="Give video.mp4 a sound track: 'click' (a click on every beat at the score's tempo, "
     "the first of each measure accented) or a music file's sound.",
 )
-def render(score, outdir, fps, size, view, style, emotion, png, audio):
+@click.option("--camera-height", type=float, default=None, help="Camera height above the floor, metres (0.4-2).")
+@click.option("--pitch", type=float, default=None, help="Camera pitch, degrees, positive looks up (-20..20).")
+@click.option("--roll", type=float, default=None, help="Camera roll about its axis, degrees (-10..10).")
+@click.option("--hfov", type=float, default=None, help="Horizontal field of view, degrees (50-80).")
+def render(score, outdir, fps, size, view, style, emotion, png, audio, camera_height, pitch, roll, hfov):
     """Perform the notation in SCORE (.lab, .json, 1974 coded input) with the
     virtual dancer and render it with its ground truth."""
     from capture2notation.notation import EMOTIONS
@@ -81,6 +115,7 @@ def render(score, outdir, fps, size, view, style, emotion, png, audio):
         raise PipelineError("--audio needs video.mp4: a folder of PNG frames (--png) has no sound track")
     if audio is not None and audio != "click" and not Path(audio).is_file():
         raise PipelineError(f"--audio {audio!r}: no such file; expected 'click' or a music file")
+    camera = _phone_camera(view, wh, camera_height, pitch, roll, hfov)
     parsed = read(score)
     video = "frames" if png else "video.mp4"
     out = render_score(
@@ -94,6 +129,7 @@ def render(score, outdir, fps, size, view, style, emotion, png, audio):
         progress=True,
         video_name=video,
         audio=audio,
+        camera=camera,
     )
     sound = "" if audio is None else (", with a click track" if audio == "click" else f", with the sound of {audio}")
     click.echo(

@@ -32,6 +32,9 @@ _HALF_WIDTH = 0.72
 _DEPTH_MARGIN = 0.35  # the nearest body part may be this much closer than the centre
 _EYE_HEIGHT = 0.62  # camera height, fraction of body height: floor and horizon both visible
 _DEFAULT_FOV_Y = 40.0
+#: Least angle, degrees, between the frame's edge and the space a performance
+#: fills that a pitched camera must leave (below it the head or feet are cut).
+_MIN_MARGIN_DEG = 3.0
 
 
 def look_at_rotation(position, target, up=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -171,6 +174,81 @@ class Camera:
         position = np.array([dist * np.sin(az), dist * np.cos(az), _EYE_HEIGHT * H])
         target = np.array([0.0, 0.0, centre_z])
         return cls.look_at(position, target, fov_y_deg, (w, h))
+
+    @classmethod
+    def phone(
+        cls,
+        view: str = "front",
+        size=(640, 480),
+        body_height: float = 1.70,
+        height: float | None = None,
+        pitch_deg: float = 0.0,
+        roll_deg: float = 0.0,
+        hfov_deg: float | None = None,
+    ) -> Camera:
+        """A phone on a tripod or a table: set height, pitch, roll and field of view.
+
+        The camera stands on the `view`'s azimuth at `height` above the
+        floor, its optical axis turned towards the performer, pitched by
+        `pitch_deg` (positive looks up) and rolled by `roll_deg` about the
+        optical axis (positive turns the camera clockwise, seen from behind
+        it).  Its distance is the nearest at which the space a performance
+        fills stays in the frame.
+
+        Parameters
+        ----------
+        view : {"front", "45", "side"}
+        size : (int, int)
+            Image (width, height), pixels.
+        body_height : float
+            Performer's height, metres.
+        height : float, optional
+            Camera centre above the floor, metres (default: the preset's).
+        pitch_deg, roll_deg : float
+            Degrees.
+        hfov_deg : float, optional
+            Horizontal field of view, degrees (default: the preset's).
+
+        Raises
+        ------
+        SyntheticError
+            A camera that cannot frame the performer (e.g. pitched down from
+            below the head so far that the head is always cut off).
+        """
+        if view not in VIEWS:
+            raise SyntheticError(f"unknown view {view!r}; expected one of {', '.join(VIEWS)}")
+        w, h = _check_size(size)
+        H = float(body_height)
+        cam_h = _EYE_HEIGHT * H if height is None else float(height)
+        half_fy0 = np.radians(_DEFAULT_FOV_Y) / 2.0
+        half_fx = np.arctan(np.tan(half_fy0) * w / h) if hfov_deg is None else np.radians(float(hfov_deg)) / 2.0
+        half_fy = np.arctan(np.tan(half_fx) * h / w)
+        # Roll turns the frame: keep the space inside the rotated frame's inscribed margin.
+        shrink = 1.0 / (1.0 + np.sin(abs(np.radians(roll_deg))) * max(w, h) / min(w, h))
+        half_up = np.arctan(np.tan(half_fy) * shrink) + np.radians(pitch_deg)
+        half_down = np.arctan(np.tan(half_fy) * shrink) - np.radians(pitch_deg)
+        if min(half_up, half_down) < np.radians(_MIN_MARGIN_DEG):
+            raise SyntheticError(
+                f"a camera {cam_h:g} m high pitched {pitch_deg:g}° with a {np.degrees(2 * half_fx):.0f}° "
+                "horizontal field of view cannot frame the whole performer"
+            )
+        top, bottom = _TOP * H - cam_h, cam_h - _BOTTOM * H
+        need = [_HALF_WIDTH * H / np.tan(np.arctan(np.tan(half_fx) * shrink))]
+        need.append(top / np.tan(half_up) if top > 0 else 0.0)
+        need.append(bottom / np.tan(half_down) if bottom > 0 else 0.0)
+        dist = max(need) + _DEPTH_MARGIN * H
+        az = np.radians(VIEWS[view])
+        position = np.array([dist * np.sin(az), dist * np.cos(az), cam_h])
+        flat = look_at_rotation(position, np.array([0.0, 0.0, cam_h]))
+        right, forward = flat[0], flat[2]
+        p, r = np.radians(pitch_deg), np.radians(roll_deg)
+        forward = np.cos(p) * forward + np.sin(p) * np.array([0.0, 0.0, 1.0])
+        down = np.cross(forward, right)
+        right, down = np.cos(r) * right + np.sin(r) * down, -np.sin(r) * right + np.cos(r) * down
+        R = np.stack([right, down, forward])
+        f = 0.5 * w / np.tan(half_fx)
+        K = np.array([[f, 0.0, w / 2.0], [0.0, f, h / 2.0], [0.0, 0.0, 1.0]])
+        return cls(K, R, -R @ position, (w, h))
 
     # ------------------------------------------------------------------ maths
     def to_camera(self, points) -> np.ndarray:

@@ -177,6 +177,7 @@ def render_score(
     body: Body | None = None,
     video_name: str = "video.mp4",
     audio: str | None = None,
+    camera: Camera | None = None,
 ) -> Path:
     """Perform a score with the virtual dancer and render it.
 
@@ -205,6 +206,8 @@ def render_score(
         Sound for the mp4: ``"click"`` (a click track at the score's tempo,
         the first beat of each measure accented) or a music file's path
         (:func:`synthetic.render.sound.add_sound`).
+    camera : Camera, optional
+        Use this camera (e.g. :meth:`Camera.phone`) instead of the `view` preset.
 
     Returns
     -------
@@ -233,6 +236,7 @@ def render_score(
         effort_json=json.dumps(asdict(score.resolved_effort())),
         progress=progress,
         video_name=video_name,
+        camera=camera,
     )
     if audio is not None:
         from .sound import add_sound

@@ -1,0 +1,288 @@
+"""The camera from the person: focal length, height, pitch, roll and the floor.
+
+One robust least-squares estimate over the whole clip, from what a pose
+model gives for each frame: the 33 image landmarks (pixels) and the world
+landmarks (metres, hip-centred, in the camera's axes; BlazePose's
+``pose_world_landmarks``).
+
+Model and noise
+---------------
+* **Focal length** ``f`` (square pixels, principal point at the image
+  centre).  Each frame's world landmarks ``W`` placed at an unknown
+  translation ``T`` project to the image landmarks:
+  ``u = cx + f (Wx + Tx) / (Wz + Tz)``, ``v`` likewise.  For a given ``f``
+  every ``T`` is linear least squares; ``f`` minimises the robust (Cauchy,
+  scale :data:`PIXEL_SIGMA`) sum of pixel residuals over the clip.  Only the
+  body's depth extent (perspective) tells ``f`` from distance, so this is
+  the weakest of the estimates; its spread is a bootstrap over blocks of
+  frames (:data:`BOOTSTRAP`), which keeps the errors' correlation in time.
+* **Scale**: world landmarks are rescaled so that the median leg (hip →
+  knee → ankle) is the body model's for `body_height`: every length, the
+  camera height among them, is in units of the assumed body height.
+* **Floor**: the up direction ``n`` in camera axes (pitch, roll) and the
+  camera height ``h`` make the floor ``n · P + h = 0``.  Residuals: each
+  frame's lowest foot point (heels and toes, along ``n``) lies at its rest
+  height above the floor (noise :data:`FLOOR_SIGMA_M`, soft-L1 so that
+  frames with both feet off the floor count little), and the trunk (mid-hip
+  → mid-shoulder) is vertical (noise :data:`AXIS_SIGMA_DEG`: dancers lean).
+  Their spread is the Gauss–Newton covariance ``s² (JᵀJ)⁻¹`` at the solution.
+
+Conventions: pitch is positive when the camera looks up, roll positive when
+it is turned clockwise seen from behind (:func:`pitch_roll`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..body import Body, joint_index
+from ..errors import FittingError
+
+__all__ = ["CameraEstimate", "estimate_camera", "pitch_roll", "up_vector"]
+
+#: Image noise of a landmark, pixels (BlazePose on 640×480 renders: a few px).
+PIXEL_SIGMA = 4.0
+#: Spread of a contact foot point about its rest height, metres (shoe, sock,
+#: the pose model's placement of heel and toe).
+FLOOR_SIGMA_M = 0.03
+#: Spread of the trunk's direction about the vertical, degrees (a dancer's
+#: lean and the pose model's error).
+AXIS_SIGMA_DEG = 6.0
+#: Horizontal fields of view searched, degrees (phones: 50-80; margin both ways).
+HFOV_RANGE_DEG = (30.0, 110.0)
+#: Bootstrap resamples of frame blocks for the focal length's spread.
+BOOTSTRAP = 24
+#: Frames per bootstrap block (about a second at 25 fps: errors persist that long).
+BLOCK_FRAMES = 25
+#: Landmarks seen at least this visibility enter the estimate.
+MIN_VISIBILITY = 0.5
+#: Fewest usable frames for an estimate.
+MIN_FRAMES = 10
+
+_HIPS, _SHOULDERS = (23, 24), (11, 12)
+_LEG = ((23, 25, 27), (24, 26, 28))  # hip, knee, ankle (left, right)
+_FOOT = (29, 30, 31, 32)  # heels, toes
+
+
+@dataclass(frozen=True)
+class CameraEstimate:
+    """A camera estimated from the person, with one standard deviation each.
+
+    Attributes
+    ----------
+    focal_px, focal_sd_px : float
+        Focal length, pixels.
+    hfov_deg : float
+        Horizontal field of view from the focal length, degrees.
+    height_m, height_sd_m : float
+        Camera centre above the floor, metres.
+    pitch_deg, pitch_sd_deg, roll_deg, roll_sd_deg : float
+        Degrees (see the module docstring for the signs).
+    up : (3,) tuple of float
+        The world's up direction in camera axes (the floor's normal).
+    frames : int
+        Frames used.
+    contacts : int
+        Frames whose lowest foot point was within 2 sd of the floor.
+    """
+
+    focal_px: float
+    focal_sd_px: float
+    hfov_deg: float
+    height_m: float
+    height_sd_m: float
+    pitch_deg: float
+    pitch_sd_deg: float
+    roll_deg: float
+    roll_sd_deg: float
+    up: tuple
+    frames: int
+    contacts: int
+
+    def as_dict(self) -> dict:
+        """Plain fields (for ``capture.npz`` and JSON)."""
+        d = asdict(self)
+        d["up"] = list(self.up)
+        return d
+
+    def K(self, image_size) -> np.ndarray:
+        """Intrinsics (3, 3) for images of `image_size` (width, height)."""
+        w, h = image_size
+        return np.array([[self.focal_px, 0.0, w / 2], [0.0, self.focal_px, h / 2], [0.0, 0.0, 1.0]])
+
+    def line(self) -> str:
+        """One line a person reads."""
+        return (
+            f"camera estimated: {self.hfov_deg:.0f}° field of view (focal {self.focal_px:.0f} ± {self.focal_sd_px:.0f} px), "
+            f"{self.height_m:.2f} ± {self.height_sd_m:.2f} m high, pitch {self.pitch_deg:+.1f} ± {self.pitch_sd_deg:.1f}°, "
+            f"roll {self.roll_deg:+.1f} ± {self.roll_sd_deg:.1f}° ({self.contacts} of {self.frames} frames on the floor)"
+        )
+
+
+def up_vector(pitch: float, roll: float) -> np.ndarray:
+    """The world's up direction in camera axes (x right, y down, z forward), radians in."""
+    cp = np.cos(pitch)
+    return np.array([-np.sin(roll) * cp, -np.cos(roll) * cp, np.sin(pitch)])
+
+
+def pitch_roll(R) -> tuple[float, float]:
+    """(pitch, roll) in degrees of a world-to-camera rotation `R` (world z up)."""
+    u = np.asarray(R, float) @ np.array([0.0, 0.0, 1.0])
+    return float(np.degrees(np.arcsin(np.clip(u[2], -1, 1)))), float(np.degrees(np.arctan2(-u[0], -u[1])))
+
+
+def _translations(f: float, uv: np.ndarray, W: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(T, 3) per-frame translations for focal `f`: the linear least squares of the projection.
+
+    ``f Tx − x Tz = x Wz − f Wx`` and ``f Ty − y Tz = y Wz − f Wy`` per
+    landmark (x, y centred pixels), weighted by `w` (T, K).
+    """
+    x, y = uv[..., 0], uv[..., 1]
+    T_, K_ = x.shape
+    A = np.zeros((T_, K_, 2, 3))
+    A[..., 0, 0] = f
+    A[..., 0, 2] = -x
+    A[..., 1, 1] = f
+    A[..., 1, 2] = -y
+    b = np.stack([x * W[..., 2] - f * W[..., 0], y * W[..., 2] - f * W[..., 1]], -1)
+    A = A.reshape(T_, 2 * K_, 3)
+    b = b.reshape(T_, 2 * K_)
+    ww = np.repeat(w, 2, axis=1)
+    AtA = np.einsum("tki,tk,tkj->tij", A, ww, A) + 1e-9 * np.eye(3)
+    Atb = np.einsum("tki,tk,tk->ti", A, ww, b)
+    return np.linalg.solve(AtA, Atb[..., None])[..., 0]
+
+
+def _reprojection_cost(f: float, uv, W, w) -> float:
+    T = _translations(f, uv, W, w)
+    P = W + T[:, None]
+    z = np.where(P[..., 2] > 1e-3, P[..., 2], np.nan)
+    r = np.hypot(f * P[..., 0] / z - uv[..., 0], f * P[..., 1] / z - uv[..., 1]) / PIXEL_SIGMA
+    return float(np.nansum(w * np.log1p(np.where(np.isfinite(r), r, 1e3) ** 2)))
+
+
+def _best_focal(uv, W, w, width: float) -> float:
+    lo, hi = (0.5 * width / np.tan(np.radians(a) / 2) for a in HFOV_RANGE_DEG[::-1])
+    grid = np.geomspace(lo, hi, 33)
+    costs = np.array([_reprojection_cost(f, uv, W, w) for f in grid])
+    i = int(np.argmin(costs))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    for _ in range(20):  # golden section on the bracket
+        m1, m2 = a + 0.382 * (b - a), a + 0.618 * (b - a)
+        if _reprojection_cost(m1, uv, W, w) < _reprojection_cost(m2, uv, W, w):
+            b = m2
+        else:
+            a = m1
+    return 0.5 * (a + b)
+
+
+def _rest_heights(body: Body) -> tuple[float, np.ndarray]:
+    """Body model's leg length (metres) and the rest heights of heel, heel, toe, toe."""
+    rest = body.rest
+    hip, knee, ankle = (joint_index(f"right_{n}") for n in ("hip", "knee", "ankle"))
+    leg = float(np.linalg.norm(rest[hip] - rest[knee]) + np.linalg.norm(rest[knee] - rest[ankle]))
+    heel = 0.008 * body.height  # LANDMARK_ATTACHMENTS' heel
+    toe = float(rest[joint_index("right_toe"), 2])
+    return leg, np.array([heel, heel, toe, toe])
+
+
+def estimate_camera(xy, visibility, world, image_size, body_height: float | None = None, seed: int = 0):
+    """Estimate the camera from a clip's image and world landmarks.
+
+    Parameters
+    ----------
+    xy : (T, 33, >=2) ndarray
+        Image landmarks, pixels.
+    visibility : (T, 33) ndarray
+        In [0, 1].
+    world : (T, 33, 3) ndarray
+        World landmarks, metres, hip-centred, camera axes (NaN when missing).
+    image_size : (width, height)
+    body_height : float, optional
+        Assumed performer height, metres (default ``Body().height``).
+    seed : int
+        Seed of the bootstrap.
+
+    Returns
+    -------
+    CameraEstimate or None
+        None when fewer than :data:`MIN_FRAMES` frames show the body and feet.
+    """
+    body = Body() if body_height is None else Body(height=float(body_height))
+    xy = np.asarray(xy, float)[..., :2]
+    vis = np.asarray(visibility, float)
+    W = np.asarray(world, float)
+    if xy.ndim != 3 or W.shape != xy.shape[:2] + (3,) or vis.shape != xy.shape[:2]:
+        raise FittingError(f"estimate_camera: xy {xy.shape}, visibility {vis.shape}, world {W.shape} do not agree")
+    w_img, h_img = (float(v) for v in image_size)
+    seen = (vis >= MIN_VISIBILITY) & np.isfinite(xy).all(-1) & np.isfinite(W).all(-1)
+    frames = np.flatnonzero(seen[:, list(_FOOT)].any(1) & seen[:, list(_HIPS + _SHOULDERS)].all(1) & (seen.sum(1) >= 8))
+    if len(frames) < MIN_FRAMES:
+        return None
+    uv = xy[frames] - np.array([w_img / 2, h_img / 2])
+    wts = seen[frames].astype(float)
+    Wf = np.where(seen[frames][..., None], W[frames], 0.0)
+    leg_model, foot_rest = _rest_heights(body)
+    legs = [
+        np.linalg.norm(Wf[:, a] - Wf[:, b], axis=-1) + np.linalg.norm(Wf[:, b] - Wf[:, c], axis=-1) for a, b, c in _LEG
+    ]
+    leg_ok = np.concatenate([lg[seen[frames][:, list(s)].all(1)] for lg, s in zip(legs, _LEG)])
+    if len(leg_ok) >= MIN_FRAMES:
+        Wf = Wf * (leg_model / float(np.median(leg_ok)))
+
+    f = _best_focal(uv, Wf, wts, w_img)
+    rng = np.random.default_rng(seed)
+    n_blocks = max(1, len(frames) // BLOCK_FRAMES)
+    blocks = np.array_split(np.arange(len(frames)), n_blocks)
+    boot = []
+    for _ in range(BOOTSTRAP if n_blocks > 1 else 0):
+        pick = np.concatenate([blocks[i] for i in rng.integers(0, n_blocks, n_blocks)])
+        boot.append(_best_focal(uv[pick], Wf[pick], wts[pick], w_img))
+    f_sd = float(np.std(boot, ddof=1)) if len(boot) > 1 else float("nan")
+
+    P = Wf + _translations(f, uv, Wf, wts)[:, None]
+    feet = P[:, list(_FOOT)]
+    feet_seen = seen[frames][:, list(_FOOT)]
+    hips = 0.5 * (P[:, 23] + P[:, 24])
+    trunk = np.concatenate([0.5 * (P[:, 11] + P[:, 12]) - hips, hips - 0.5 * (P[:, 27] + P[:, 28])])
+    trunk /= np.linalg.norm(trunk, axis=-1, keepdims=True)
+    sigma_axis = np.radians(AXIS_SIGMA_DEG)
+
+    def residuals(p):
+        n = up_vector(p[0], p[1])
+        heights = feet @ n + p[2] - foot_rest  # each foot point's height above its rest height
+        heights = np.where(feet_seen, heights, np.inf)
+        lowest = heights.min(1)
+        axis = np.cross(trunk, n)  # sine of the trunk's angle from the vertical
+        return np.concatenate([lowest / FLOOR_SIGMA_M, axis.ravel() / sigma_axis])
+
+    # Start: a level camera, its height from the lowest foot points along −y.
+    h0 = float(np.median(np.nanmax(np.where(feet_seen, feet[..., 1], np.nan), 1)))
+    sol = least_squares(residuals, [0.0, 0.0, h0], loss="cauchy", f_scale=1.0, x_scale=[0.1, 0.1, 0.5])
+    J = sol.jac
+    m, k = J.shape
+    s2 = 2.0 * float(sol.cost) / max(m - k, 1)
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2
+        sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    except np.linalg.LinAlgError:
+        sd = np.full(3, np.nan)
+    pitch, roll, height = (float(v) for v in sol.x)
+    contacts = int(np.sum(np.abs(residuals(sol.x)[: len(frames)]) < 2.0))
+    return CameraEstimate(
+        focal_px=float(f),
+        focal_sd_px=f_sd,
+        hfov_deg=float(np.degrees(2 * np.arctan(0.5 * w_img / f))),
+        height_m=height,
+        height_sd_m=float(sd[2]),
+        pitch_deg=float(np.degrees(pitch)),
+        pitch_sd_deg=float(np.degrees(sd[0])),
+        roll_deg=float(np.degrees(roll)),
+        roll_sd_deg=float(np.degrees(sd[1])),
+        up=tuple(float(v) for v in up_vector(pitch, roll)),
+        frames=len(frames),
+        contacts=contacts,
+    )
