@@ -20,6 +20,8 @@ __all__ = [
     "FEATURES",
     "PERFORMER_SD",
     "SPREAD",
+    "TEMPERATURE",
+    "emotion_log_likelihoods",
     "emotion_probabilities",
     "features",
     "preset_features",
@@ -44,6 +46,13 @@ PERFORMER_SD = (0.3, 0.05, 0.25, 0.1)
 SPREAD = (0.2974, 0.0446, 0.1861, 0.1052)
 
 
+#: Temperature of the emotion probabilities (log-likelihoods divided by it):
+#: fitted by ``benchmarks/bench_effort_coverage.py --derive`` on held-out
+#: synthetic performances (fitting seed 2005) so that the claims are
+#: calibrated on fresh seeds (the reliability table in docs/benchmarks/effort.md).
+TEMPERATURE = 3.38
+
+
 def preset_features() -> tuple[tuple[str, ...], np.ndarray]:
     """Emotion names and their (4,) feature vectors, shape (E, 4)."""
     names = tuple(PRESETS)
@@ -58,7 +67,7 @@ def features(time: float, weight: float, space: float, tempo: float) -> np.ndarr
     return np.array([time, weight, space, np.log(tempo)], dtype=float)
 
 
-def emotion_probabilities(x, sd=None, spread=SPREAD) -> dict:
+def emotion_probabilities(x, sd=None, spread=SPREAD, temperature: float = TEMPERATURE) -> dict:
     """Posterior probability of each emotion preset for one performance.
 
     Parameters
@@ -70,11 +79,25 @@ def emotion_probabilities(x, sd=None, spread=SPREAD) -> dict:
         uncertainty of this performance), added in quadrature to `spread`.
     spread : (4,) array_like
         Calibrated spread of the features about the presets.
+    temperature : float
+        Divides the log-likelihoods (see :data:`TEMPERATURE`).
 
     Returns
     -------
     dict
         ``{emotion: p}`` over the four presets, summing to 1.
+    """
+    names, _ = preset_features()
+    ll = emotion_log_likelihoods(x, sd, spread) / float(temperature)
+    p = np.exp(ll - ll.max())
+    p /= p.sum()
+    return {n: float(v) for n, v in zip(names, p)}
+
+
+def emotion_log_likelihoods(x, sd=None, spread=SPREAD) -> np.ndarray:
+    """(E,) Gaussian log-likelihood of `x` under each preset, in :data:`PRESETS` order (equal normalisers).
+
+    Parameters as for :func:`emotion_probabilities`.
     """
     x = np.asarray(x, dtype=float)
     if x.shape != (4,) or not np.all(np.isfinite(x)):
@@ -82,11 +105,8 @@ def emotion_probabilities(x, sd=None, spread=SPREAD) -> dict:
     var = np.asarray(spread, dtype=float) ** 2
     if sd is not None:
         var = var + np.nan_to_num(np.asarray(sd, dtype=float), nan=0.0) ** 2
-    names, mu = preset_features()
-    ll = -0.5 * np.sum((x - mu) ** 2 / var, axis=1)  # (E,) equal normalisers
-    p = np.exp(ll - ll.max())
-    p /= p.sum()
-    return {n: float(v) for n, v in zip(names, p)}
+    _, mu = preset_features()
+    return -0.5 * np.sum((x - mu) ** 2 / var, axis=1)
 
 
 def same_or_different(p1: dict, p2: dict) -> bool:

@@ -32,8 +32,13 @@ def test_uncertainty_spreads_the_probabilities():
     assert entropy[1] > entropy[0]
     # happy and angry share a tempo: halfway between them, tempo says nothing
     mid = 0.5 * (mu[names.index("happy")] + mu[names.index("angry")])
-    p = emotion_probabilities(mid)
+    p = emotion_probabilities(mid, temperature=1.0)
     assert p["happy"] + p["angry"] > 0.99
+    # the calibrated temperature softens the claim but keeps the two equal and ahead
+    q = emotion_probabilities(mid)
+    assert q["happy"] == pytest.approx(q["angry"], rel=1e-9) and min(q["happy"], q["angry"]) > max(
+        q["sad"], q["afraid"]
+    )
 
 
 def test_same_or_different_and_bad_features():
@@ -45,3 +50,17 @@ def test_same_or_different_and_bad_features():
     with pytest.raises(EffortError, match="4 finite"):
         emotion_probabilities([np.nan, 0.5, 0.5, 4.0])
     assert len(SPREAD) == 4 and all(v > 0 for v in SPREAD)
+
+
+def test_temperature_flattens_and_keeps_the_order():
+    from capture2notation.effort.emotion import emotion_log_likelihoods
+
+    names, mu = preset_features()
+    x = 0.5 * (mu[names.index("sad")] + mu[names.index("afraid")]) + np.array([0.05, 0.0, 0.2, 0.0])
+    ll = emotion_log_likelihoods(x)
+    sharp, flat = emotion_probabilities(x, temperature=0.5), emotion_probabilities(x, temperature=4.0)
+    assert max(sharp, key=sharp.get) == max(flat, key=flat.get) == names[int(np.argmax(ll))]
+    assert max(flat.values()) < max(sharp.values())
+    # temperature 1 is the plain Gaussian posterior over equal priors
+    p = np.exp(ll - ll.max())
+    assert emotion_probabilities(x, temperature=1.0)["sad"] == pytest.approx(p[names.index("sad")] / p.sum())
