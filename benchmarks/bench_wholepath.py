@@ -9,7 +9,9 @@ the mannequin, and captured twice:
 
 * from the truth sidecar (no perception: the quantiser alone), and
 * from the video (BlazePose → 3D fit → quantiser), the tempo estimated
-  (or given, ``--tempo-given``).
+  (or given, ``--tempo-given``), the camera estimated from the person (or
+  the renderer's true camera given explicitly, ``--calibrated``: the named
+  calibrated condition; a capture never reads the sidecar itself).
 
 Printed (never asserted): per phrase and overall, the symbol agreement
 (direction + level per part per beat of the original) and overall the
@@ -107,6 +109,7 @@ def measure(
     tempo_given: bool = False,
     flip_test: bool | None = None,
     keypoints: str = "blazepose",
+    calibrated: bool = False,
 ) -> dict:
     """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
     from capture2notation.compare.agreement import agreement_cells, compare_scores
@@ -135,6 +138,7 @@ def measure(
             effort=effort,
             overlay=False,
             tempo=score.tempo if tempo_given else None,
+            calibration=render / "camera.toml" if calibrated else None,
             **({} if flip_test is None else {"flip_test": flip_test}),
         )
     seconds = time.perf_counter() - t0
@@ -147,14 +151,24 @@ def measure(
         "truth_exact": exact,
         "tempo": (float(score.tempo), float(video.score.tempo)),
         "limb_deg": _limb_error(np.asarray(truth.joints), np.asarray(video.motion.joints)),
-        # Not root-aligned: with the render's camera known, the fit's absolute
-        # position is part of what it gets right or wrong.
-        "mpjpe_cm": 100 * float(np.nanmean(mpjpe(np.asarray(truth.joints), np.asarray(video.motion.joints)))),
+        # With the true camera the fit's absolute position is part of what it
+        # gets right or wrong; without it, the position of the whole body along
+        # the camera's axis is not observable, so joints are compared about
+        # the pelvis.
+        "mpjpe_cm": 100 * float(np.nanmean(mpjpe(*_placed(truth.joints, video.motion.joints, calibrated)))),
         "fps": truth.n_frames / seconds,
         "frames": truth.n_frames,
         "missed": [c for c in cells if c.ref != c.cand],
         "cells": len(cells),
     }
+
+
+def _placed(ref, cand, absolute: bool):
+    """`ref` and `cand` joints (T, J, 3) as compared: absolute, or about the pelvis (joint 0)."""
+    ref, cand = np.asarray(ref, float), np.asarray(cand, float)
+    if absolute:
+        return ref, cand
+    return ref - ref[:, :1], cand - cand[:, :1]
 
 
 def _explain(missed) -> str:
@@ -185,12 +199,27 @@ def main() -> None:
         help="render: fit the renderer's own landmarks instead (perfect keypoints); render-world, "
         "render-2d: replace only BlazePose's world landmarks, or only its pixels",
     )
+    ap.add_argument(
+        "--calibrated",
+        action="store_true",
+        help="give the capture the renderer's true camera (--calibration camera.toml); "
+        "by default it sees only the video, as a user's capture does",
+    )
     args = ap.parse_args()
     paths = sorted(args.phrases.glob("*.lab"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for p in paths:
-            r = measure(p, Path(tmp) / p.stem, args.view, args.effort, args.tempo_given, args.flip_test, args.keypoints)
+            r = measure(
+                p,
+                Path(tmp) / p.stem,
+                args.view,
+                args.effort,
+                args.tempo_given,
+                args.flip_test,
+                args.keypoints,
+                args.calibrated,
+            )
             rows.append(r)
             print(
                 f"{r['phrase']:<22} agreement {r['agreement']:6.1%}  start error {r['start_error']:5.2f} beat  "
@@ -203,7 +232,10 @@ def main() -> None:
     frames = sum(r["frames"] for r in rows)
     weights = np.array([r["frames"] for r in rows], float)
     how = "given" if args.tempo_given else "estimated"
-    print(f"\n{args.view} view, {len(rows)} phrases, {frames} frames, tempo {how}, {args.keypoints} keypoints:")
+    camera = "true camera given" if args.calibrated else "camera estimated from the video"
+    print(
+        f"\n{args.view} view, {len(rows)} phrases, {frames} frames, tempo {how}, {args.keypoints} keypoints, {camera}:"
+    )
     print(f"  symbol agreement (mean over phrases)  {np.mean([r['agreement'] for r in rows]):.1%}")
     # The columns compared are the parts either score moves, so a capture
     # that writes fewer spurious symbols can lose cells *and* percentage:

@@ -24,9 +24,11 @@ or estimated from the movements and, for a video with a sound track, its
 beat (:mod:`capture2notation.quantise.beats`, the optional ``audio`` extra);
 the page and the command line say which, and how sure.
 
-For a rendered video with its ``truth.npz`` beside it, the fit uses the
-sidecar's camera (known intrinsics and pose); otherwise the fitting stage's
-default camera refined from the data.
+A capture reads only its input and the options given (DESIGN.md, "What a
+capture may know"): a known camera comes from ``calibration=``
+(``--calibration cameras.toml``; ``c2n render`` writes its true camera as
+``camera.toml`` for experiments), otherwise the fitting stage estimates the
+camera from the person.  Files lying beside the input are never read.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ import numpy as np
 from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
 from capture2notation.errors import C2NError, PipelineError, QuantiseError
+from capture2notation.fitting.motion import joints_for_labels
 from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW, Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.confidence import score_confidence
@@ -154,9 +157,22 @@ def _with_fps(motion, fps: float):
 
 
 def load_motion(
-    path, kind: str, backend: str = "blazepose", fps_override=None, progress: bool = True, flip_test: bool = False
+    path,
+    kind: str,
+    backend: str = "blazepose",
+    fps_override=None,
+    progress: bool = True,
+    flip_test: bool = False,
+    calibration=None,
 ):
     """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
+
+    Parameters
+    ----------
+    calibration : str or Path, optional
+        A calibration file (DESIGN.md, "Cameras and calibration files") with
+        the video's camera; without it the fit estimates the camera from the
+        person.  Nothing beside the input is ever read in its place.
 
     Returns
     -------
@@ -170,20 +186,24 @@ def load_motion(
         from capture2notation.fitting import Camera, fit_track
         from capture2notation.keypoints import extract
 
+        known = None
+        if calibration is not None:
+            from capture2notation.io.calibration import read_calibration
+
+            known = read_calibration(calibration)
         t0 = time.perf_counter()
         track = extract(path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test)
         seconds["keypoints"] = time.perf_counter() - t0
         camera = None
-        sidecar = Path(path).parent / "truth.npz" if Path(path).is_file() else Path(path) / "truth.npz"
-        if sidecar.is_file():
-            from capture2notation.io.truth import read_truth
-
-            camera = Camera.from_truth(read_truth(sidecar))
-            log.info("capture: using the camera of %s", sidecar)
+        if known is not None:
+            camera = Camera.from_calibration(known, path, track.image_size)
+            log.info("capture: using the camera of %s", calibration)
         t0 = time.perf_counter()
         motion = fit_track(track, camera=camera)
         seconds["fitting"] = time.perf_counter() - t0
         return motion, track, seconds
+    if calibration is not None:
+        raise PipelineError(f"--calibration {calibration}: a camera is for video input, not a {kind} file")
     from capture2notation.fitting.motion import read_motion
 
     t0 = time.perf_counter()
@@ -226,6 +246,8 @@ def capture(
     seed: int = 0,
     overlay: bool = True,
     flip_test: bool = False,
+    axes: str = "standard",
+    calibration=None,
 ) -> CaptureResult:
     """Capture notation from a video or motion file.
 
@@ -258,6 +280,10 @@ def capture(
     flip_test : bool
         BlazePose also reads a mirrored copy of each crop (see
         :class:`capture2notation.keypoints.BlazePose`): more accurate, slower.
+    axes : {"standard", "body"}
+        The score's key (DESIGN.md, "Cross of axes").
+    calibration : str or Path, optional
+        Calibration file with the video's camera (see :func:`load_motion`).
 
     Returns
     -------
@@ -266,8 +292,13 @@ def capture(
     _check_options(backend, tempo, fps_override)
     kind = input_kind(input_path)
     outdir = Path(outdir)
-    motion, track, seconds = load_motion(input_path, kind, backend, fps_override, progress, flip_test)
-    joints = np.asarray(motion.joints, dtype=float)
+    motion, track, seconds = load_motion(
+        input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration
+    )
+    # The body key is LabanotationSuite's reading of a Kinect's own arm
+    # positions; the standard key keeps the fit throughout.
+    measured_arms = kind != "video" and axes == "body"
+    joints = joints_for_labels(motion) if measured_arms else np.asarray(motion.joints, dtype=float)
     fps = float(motion.fps)
     if not np.isfinite(joints).any():
         raise PipelineError(f"{input_path}: no frame could be measured (no person found?)")
@@ -281,13 +312,17 @@ def capture(
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
     given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
     try:
-        seg = segment_motion(joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence)
+        seg = segment_motion(
+            joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence, axes=axes
+        )
     except QuantiseError as exc:
         if tempo is not None:
             raise
         # Too few movements for a beat: time as it is, one beat a second, and say so.
         log.warning("capture: no beat found (%s): writing %d bpm, one beat a second", exc, SECONDS_TEMPO)
-        seg = segment_motion(joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title)
+        seg = segment_motion(
+            joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title, axes=axes
+        )
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)

@@ -3,8 +3,9 @@
 OpenCV convention (ARCHITECTURE.md): ``x_cam = R @ x_world + t`` with camera
 x right, y down, z forward; pixels ``u = fx·x/z + cx``, ``v = fy·y/z + cy``.
 
-A render's truth sidecar gives ``K``, ``R``, ``t`` exactly.  For other video
-the camera is :meth:`Camera.default`: upright and level, in front of the
+A known camera comes only from a calibration file the user names
+(:meth:`Camera.from_calibration`; DESIGN.md, "What a capture may know").
+Otherwise the camera is :meth:`Camera.default`: upright and level, in front of the
 performer (on +y, looking towards −y) at :data:`DEFAULT_DISTANCE` and
 :data:`DEFAULT_HEIGHT`, with a horizontal field of view of
 :data:`DEFAULT_HFOV_DEG`; the fitter refines the focal length from the data
@@ -21,6 +22,9 @@ from ..errors import FittingError
 
 __all__ = ["DEFAULT_DISTANCE", "DEFAULT_HEIGHT", "DEFAULT_HFOV_DEG", "Camera"]
 
+#: Largest distortion coefficient the pinhole fit ignores: at 1e-3 a point at
+#: the image corner moves by well under a pixel at phone resolutions.
+_MAX_IGNORED_DISTORTION = 1e-3
 #: Default horizontal field of view, degrees (a phone's main camera is 65-75°
 #: in landscape; rehearsal footage is often zoomed a little).
 DEFAULT_HFOV_DEG = 60.0
@@ -111,6 +115,50 @@ class Camera:
                 raise FittingError(f"truth sidecar has no camera field {name!r}") from None
 
         return cls(get("K"), get("R"), get("t"), tuple(int(v) for v in np.asarray(get("image_size")).tolist()))
+
+    @classmethod
+    def from_calibration(cls, calibration, video, image_size) -> Camera:
+        """The camera of `video` in a calibration (``capture2notation.io.calibration``).
+
+        Parameters
+        ----------
+        calibration : Calibration
+            As read by :func:`~capture2notation.io.calibration.read_calibration`.
+        video : str or Path
+            The clip; with several cameras in the calibration, its camera is the
+            one named :func:`~capture2notation.io.calibration.camera_name` of it.
+            A calibration of one camera is that clip's camera whatever its name.
+        image_size : (int, int)
+            (width, height) of the clip's frames, pixels; must equal the
+            calibration's (a calibration of other images does not describe them).
+
+        Raises
+        ------
+        FittingError
+            No camera of that name, or other image sizes.  Distortion is not
+            modelled by the fit: a calibration with distortion is refused.
+        """
+        from ..errors import CalibrationError
+        from ..io.calibration import camera_name
+
+        names = calibration.names
+        name = names[0] if len(names) == 1 else camera_name(video)
+        try:
+            cam = calibration[name]
+        except CalibrationError as exc:
+            raise FittingError(f"{video}: {exc}") from None
+        size = tuple(int(v) for v in image_size)
+        if tuple(cam.image_size) != size:
+            raise FittingError(
+                f"{video}: frames are {size[0]}x{size[1]} but camera {name!r} is calibrated for "
+                f"{cam.image_size[0]}x{cam.image_size[1]}"
+            )
+        if np.any(np.abs(cam.dist) > _MAX_IGNORED_DISTORTION):
+            raise FittingError(
+                f"{video}: camera {name!r} has lens distortion {np.round(cam.dist, 4).tolist()}; "
+                "undistort the clip first (the fit models a pinhole camera)"
+            )
+        return cls(np.asarray(cam.K), np.asarray(cam.R), np.asarray(cam.t), size)
 
     def with_focal(self, f: float) -> Camera:
         """The same camera with focal length `f` pixels (both axes)."""

@@ -24,7 +24,14 @@ from .fit3d import fit_points3d
 from .model import PoseModel
 from .result import FitResult
 
-__all__ = ["MotionData", "motion_from_truth", "normalise_world", "read_motion"]
+__all__ = [
+    "MEASURED_FOR_LABELS",
+    "MotionData",
+    "joints_for_labels",
+    "motion_from_truth",
+    "normalise_world",
+    "read_motion",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,9 +42,49 @@ class MotionData(FitResult):
     ----------
     source : str
         ``"bvh"``, ``"kinect"`` or ``"truth"``.
+    measured : (T, J, 3) ndarray or None
+        Kinect: the file's own joint positions on our joint names, in the
+        fit's world frame (NaN where the file has none or lost track).  The
+        retargeted fit keeps our bone lengths and joint limits and moves a
+        hanging upper arm by 20-30°; labels are read from these.
     """
 
     source: str = ""
+    measured: np.ndarray | None = None
+
+
+#: Joints whose measured positions (Kinect) are read instead of the fit's:
+#: the body cross (shoulders, mid-spine) and the arms.  Legs and feet keep
+#: the fit (its floor, foot pitch and bone lengths are what the supports are
+#: read from), and so does the head (the sensor's Head point sits at the
+#: skull's centre, not where our head joint is).
+MEASURED_FOR_LABELS = (
+    "waist",
+    "right_shoulder",
+    "left_shoulder",
+    "right_elbow",
+    "left_elbow",
+    "right_wrist",
+    "left_wrist",
+)
+
+
+def joints_for_labels(motion: MotionData) -> np.ndarray:
+    """(T, J, 3) the joints a motion file is written from: the fit, with
+    :data:`MEASURED_FOR_LABELS` taken from the file where it measured them.
+
+    LabanotationSuite reads a Kinect capture's arms from the sensor's own
+    positions; so do we (on its sample, 100 % of its per-frame arm labels
+    in the body key, against 54-85 % from the retargeted fit).
+    """
+    joints = np.asarray(motion.joints, float)
+    if motion.measured is None:
+        return joints
+    out = joints.copy()
+    idx = [joint_index(n) for n in MEASURED_FOR_LABELS]
+    m = np.asarray(motion.measured, float)[:, idx]
+    out[:, idx] = np.where(np.isfinite(m), m, out[:, idx])
+    return out
 
 
 def read_motion(path, joint_map: dict | None = None, body: Body | None = None) -> MotionData:
@@ -74,7 +121,7 @@ def read_motion(path, joint_map: dict | None = None, body: Body | None = None) -
         points, conf, head, head_c = kinect_points(pos, kconf)
         if not np.any(conf > 0):
             raise MotionFileError(f"{path}: no tracked joints in any row")
-        return _fit(points, conf, head, head_c, fps, times, body, "kinect")
+        return _fit(points, conf, head, head_c, fps, times, body, "kinect", keep_points=True)
     if ext == ".npz":
         return motion_from_truth(path)
     raise MotionFileError(f"{path}: unknown motion file type {ext!r}; expected .bvh, .csv (Kinect v2) or .npz (truth)")
@@ -96,12 +143,15 @@ def _own_motion(fps, angles, root, offsets) -> MotionData:
     )
 
 
-def _fit(points, conf, head, head_c, fps, times, body, source) -> MotionData:
+def _fit(points, conf, head, head_c, fps, times, body, source, keep_points: bool = False) -> MotionData:
     extra = [] if head is None else [head]
     points, extra = normalise_world(points, conf, extra)
     virtual = {} if head is None else {"head_centre": (extra[0], head_c)}
     res = fit_points3d(points, conf, fps, body=body, times=times, virtual=virtual)
-    return MotionData(**{k: getattr(res, k) for k in res.__dataclass_fields__}, source=source)
+    measured = None
+    if keep_points and points.shape == res.joints.shape:
+        measured = np.where((np.asarray(conf) > 0)[..., None], points, np.nan)
+    return MotionData(**{k: getattr(res, k) for k in res.__dataclass_fields__}, source=source, measured=measured)
 
 
 def motion_from_truth(path) -> MotionData:

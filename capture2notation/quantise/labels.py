@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..atomic import write_text
-from ..body import JOINTS, Body, body_frame, joint_index
+from ..body import JOINTS, Body, body_frame, joint_index, key_frame
 from ..errors import QuantiseError
 from ..notation.directions import bend_angle, bend_degree, classify_indices
 from ..notation.model import DIRECTIONS, LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, SUPPORT_PARTS
@@ -229,7 +229,16 @@ def support_frames(
     return supporting, level
 
 
-def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLabels:
+#: Parts read in the body cross of axes under the body key (DESIGN.md, "Cross
+#: of axes"): the arms and the head, as LabanotationSuite reads them; the
+#: chest and the legs keep the standard cross (the chest's own tilt is what
+#: its symbol writes; the legs are read from the hips).
+BODY_KEY_PARTS = frozenset(
+    ("right_arm", "left_arm", "right_upper_arm", "right_forearm", "left_upper_arm", "left_forearm", "head")
+)
+
+
+def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0, axes: str = "standard") -> FrameLabels:
     """Label every part at every frame with the DESIGN.md thresholds.
 
     Parameters
@@ -240,6 +249,11 @@ def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLab
         Frames per second (> 0).
     floor : float
         Floor height in metres.
+    axes : str
+        ``"standard"``: every part in the standard cross (:func:`body_frame`,
+        upright, turning with the hips); ``"body"``: the parts of
+        :data:`BODY_KEY_PARTS` in the body cross (:func:`body_cross`, along
+        the torso).
 
     Returns
     -------
@@ -259,6 +273,7 @@ def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLab
     T = joints.shape[0]
     P = len(LABEL_PARTS)
     frame = body_frame(joints)
+    cross = key_frame(joints, axes) if axes != "standard" else frame
     vectors = np.full((T, P, 3), np.nan)
     bend_deg = np.full((T, P), np.nan)
     for p, part in enumerate(PART_SEGMENTS):
@@ -267,7 +282,7 @@ def label_frames(joints: np.ndarray, fps: float, floor: float = 0.0) -> FrameLab
         n = np.linalg.norm(v, axis=-1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             v = np.where(n > 1e-12, v / n, np.nan)
-        vectors[:, p] = np.einsum("tij,tj->ti", frame, v)
+        vectors[:, p] = np.einsum("tij,tj->ti", cross if part in BODY_KEY_PARTS else frame, v)
         if part in PART_MIDDLE_JOINT:
             m = PART_MIDDLE_JOINT[part]
             bend_deg[:, p] = bend_angle(joints[:, joint_index(a)], joints[:, joint_index(m)], joints[:, joint_index(b)])

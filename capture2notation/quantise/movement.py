@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 __all__ = ["Movement"]
 
@@ -13,7 +14,8 @@ class Movement:
 
     ``start_time`` / ``end_time`` are the estimated instants the movement
     begins and arrives (seconds); ``end_frame`` is the first frame at the
-    arrival pose.
+    arrival pose.  ``amount`` is a turn's full turns (None otherwise; its
+    ``level`` is then ``""``).
     """
 
     part: str
@@ -24,3 +26,4 @@ class Movement:
     direction: str
     level: str
     bend: int = 0
+    amount: Fraction | None = None

@@ -76,13 +76,16 @@ from scipy.signal import savgol_filter
 from ..body import joint_index
 from ..errors import QuantiseError
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
+from .flight import find_flights, with_flights
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .measured import held_pose, hold_frames, keep_previous, upright_trunk
 from .movement import Movement
 from .spans import _ZERO_SPEED, movement_spans
-from .supports import NOISY_POSITION_M, position_noise, smooth_positions, support_movements
+from .supports import NOISY_POSITION_M, body_height, position_noise, smooth_positions, support_movements
 from .tempo import estimate_tempo_detail, snap
 from .timing import progress_signal, refine_times
+from .travel import unturn
+from .turns import turn_movements, turned_so_far
 
 __all__ = ["Movement", "SegmentParams", "Segmentation", "movement_spans", "segment", "segment_motion"]
 
@@ -289,6 +292,7 @@ def segment_motion(
     floor: float = 0.0,
     title: str = "",
     tempo_evidence=None,
+    axes: str = "standard",
 ) -> Segmentation:
     """Segment a motion into notation symbols.
 
@@ -309,19 +313,28 @@ def segment_motion(
     tempo_evidence : TempoEvidence, optional
         Evidence on the tempo besides the movements (a sound track's beats,
         :mod:`capture2notation.quantise.beats`), when it is estimated.
+    axes : str
+        The score's key: ``"standard"`` or ``"body"`` (arms and head read in
+        the body cross of axes, :func:`~.labels.label_frames`).
 
     Returns
     -------
     Segmentation
     """
     params = params or SegmentParams()
-    labels = label_frames(joints, fps, floor)
+    labels = label_frames(joints, fps, floor, axes=axes)
     T = labels.direction.shape[0]
     if T < 2:
         raise QuantiseError(f"need at least 2 frames to segment a motion, got {T}")
     joints = np.asarray(joints, dtype=float)
     # Measured motion (fits, mocap) is never exactly still, however smooth.
     measured = not _has_exact_holds(labels, joints)
+    # Turns are read from the motion as it is; supports and steps from the
+    # motion with its turns undone about their pivots (:mod:`.travel`).
+    turning, turned = joints, turned_so_far(joints, fps, measured)
+    if np.any(turned != 0.0):
+        joints = unturn(joints, turned, labels.supporting)
+        labels = label_frames(joints, fps, floor, axes=axes)
     noisy_feet = measured or position_noise(joints) > NOISY_POSITION_M
     if noisy_feet:
         # Jitter of a centimetre is 0.5 m/s frame to frame: feet would never
@@ -333,11 +346,23 @@ def segment_motion(
         # raised from the capture's own flat foot, not from the model's.
         flat = flat_foot_pitch(smoothed, contact) if measured else None
         labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat))
+    # Flight from the feet's heights (smoothed when measured), before the supports are written.
+    flights = find_flights(smoothed if noisy_feet else joints, fps, measured, floor)
+    height = body_height(joints)
     estimated = tempo_was_none = tempo is None
     moves, detail = None, None
     if estimated:
-        moves = _gesture_movements(labels, joints, fps, params, measured=measured) + support_movements(
-            labels, joints, fps, params, movement_spans, measured=measured
+        moves = (
+            _gesture_movements(labels, joints, fps, params, measured=measured)
+            + with_flights(
+                support_movements(labels, joints, fps, params, movement_spans, measured=measured),
+                labels,
+                joints,
+                fps,
+                flights,
+                height,
+            )
+            + turn_movements(turning, fps, measured)
         )
         clean = not measured and all(_noise_deg(labels.vectors[:, labels.index(p)]) <= _CLEAN_NOISE_DEG for p in _LIMBS)
         # Gestures set the tempo when there are a few of them: support
@@ -385,14 +410,29 @@ def segment_motion(
     )
     if moves is None or not noisy:
         on_grid = _grid_frames(T, fps, tempo, params.grid)
-        moves = _gesture_movements(labels, joints, fps, params, on_grid, measured) + support_movements(
-            labels, joints, fps, params, movement_spans, on_grid, measured=measured
+        turns = turn_movements(turning, fps, measured, on_grid)
+        ends = np.zeros(T, bool)
+        ends[[min(m.end_frame, T - 1) for m in turns]] = True
+        moves = (
+            _gesture_movements(labels, joints, fps, params, on_grid, measured)
+            + with_flights(
+                support_movements(
+                    labels, joints, fps, params, movement_spans, on_grid, measured=measured, turn_ends=ends
+                ),
+                labels,
+                joints,
+                fps,
+                flights,
+                height,
+                None if noisy else on_grid,
+            )
+            + turns
         )
     moves.sort(key=lambda m: (m.start_time, m.part))
     merged = _merge_times(moves, params, float(tempo))
     symbols = _symbols(merged, tempo, params.grid)
     key_frames = np.unique(np.r_[0, [min(m.end_frame, T - 1) for m in moves]].astype(int))
-    score = Score(symbols=tuple(symbols), title=title, tempo=tempo, meter=meter)
+    score = Score(symbols=tuple(symbols), title=title, tempo=tempo, meter=meter, axes=axes)
     if detail is None:
         source = "no beat" if tempo_was_none else "given"
         return Segmentation(score, tuple(moves), key_frames, tempo, estimated, labels, tempo_source=source)
@@ -864,6 +904,6 @@ def _symbols(moves: list[Movement], tempo: Fraction, grid: Fraction) -> list[Sym
         start = max(start, last_end.get(m.part, Fraction(0)))
         if end <= start:
             end = start + grid
-        out.append(Symbol(start, end - start, m.part, m.direction, m.level, m.bend))
+        out.append(Symbol(start, end - start, m.part, m.direction, m.level or None, m.bend, m.amount))
         last_end[m.part] = end
     return out

@@ -231,6 +231,7 @@ def support_movements(
     spans_fn,
     on_grid: np.ndarray | None = None,
     measured: bool = False,
+    turn_ends: np.ndarray | None = None,
 ) -> list:
     """Support movements as :class:`~.segment.Movement` objects (see the module docstring).
 
@@ -238,7 +239,9 @@ def support_movements(
     fitted or recorded, never exactly still however smooth): see
     :func:`_noisy_support_movements`; `labels` should then carry the contacts
     of smoothed joints (:func:`smooth_positions`, as
-    :func:`~.segment.segment_motion` does).
+    :func:`~.segment.segment_motion` does).  `turn_ends` (T,) bool, clean
+    motion: frames where a turn arrives, where a support on one foot may
+    part too (a pirouette's relevé ends with its turn).
     """
 
     T = joints.shape[0]
@@ -261,9 +264,9 @@ def support_movements(
         axis=1,
     )
     spans = spans_fn(
-        speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps)
+        speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps, turn_ends)
     )
-    height = _body_height(joints)
+    height = body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
     out = []
     for a, b in spans:
@@ -371,7 +374,7 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     runs = _feet_that_stay_down(runs, lifted, min_len)
     runs = _no_touch_downs(runs, lifted, min_len)
     runs, passed = _without_passages(runs, smooth[:, joint_index("pelvis"), 2], fps)
-    height = _body_height(smooth)
+    height = body_height(smooth)
     offset = _standing_foot_offset(smooth, labels.supporting)
     pelvis = joints[:, joint_index("pelvis")]
     out = []
@@ -717,7 +720,7 @@ def _pelvis_plie(part: np.ndarray, level: np.ndarray, joints: np.ndarray) -> np.
     if flat.sum() < 5:
         return level
     ref = float(np.percentile(z[flat], 75))
-    drop = PLIE_DROP_FRACTION * _body_height(joints)
+    drop = PLIE_DROP_FRACTION * body_height(joints)
     return np.where(flat, np.where(z < ref - drop, low, LEVELS.index("middle")), level)
 
 
@@ -740,7 +743,14 @@ def _pelvis_window(pelvis: np.ndarray, lo: int, a: int, b: int, hi: int, fps: fl
     return np.arange(lo, hi + 1) / fps, prog, 0.5 * (lo + a) / fps, 0.5 * (b + hi) / fps
 
 
-def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray | None, knees=None, fps: float = 25.0):
+def _support_cut_fn(
+    labels: FrameLabels,
+    speed: np.ndarray,
+    on_grid: np.ndarray | None,
+    knees=None,
+    fps: float = 25.0,
+    turn_ends: np.ndarray | None = None,
+):
     """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements.
 
     Either a foot lands at f (it supports at f and did not at f - 1), or
@@ -762,7 +772,7 @@ def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray 
             return False
         if landed[f]:
             return True
-        if not down[f]:
+        if not down[f] and not (turn_ends is not None and turn_ends[f] and sup[f].any()):
             return False
         if knees is not None and 0 < f < len(knees) - 1:
             k = knees[f - 1 : f + 2]
@@ -784,7 +794,7 @@ def _support_cut_fn(labels: FrameLabels, speed: np.ndarray, on_grid: np.ndarray 
     return key
 
 
-def _body_height(joints: np.ndarray) -> float:
+def body_height(joints: np.ndarray) -> float:
     """Body height from the leg length (hip → ankle is 0.491 of the height at rest)."""
     leg = np.nanmedian(
         np.linalg.norm(joints[:, joint_index("right_hip")] - joints[:, joint_index("right_knee")], axis=-1)

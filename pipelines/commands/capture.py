@@ -47,7 +47,23 @@ __all__ = ["capture"]
     is_flag=True,
     help="BlazePose also reads a mirrored copy of each crop (more accurate in side views; slower).",
 )
-def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test):
+@click.option(
+    "--axes",
+    type=click.Choice(["standard", "body"]),
+    default="standard",
+    show_default=True,
+    help="Cross of axes limb directions are read in: 'standard' (vertical from gravity, front from the hips) "
+    "or 'body' (arms and head along the torso, as LabanotationSuite reads Kinect captures).",
+)
+@click.option(
+    "--calibration",
+    type=click.Path(dir_okay=False, path_type=str),
+    default=None,
+    metavar="FILE",
+    help="A calibration file (TOML, as written by c2n render's camera.toml) with the video's camera; "
+    "by default the camera is estimated from the person.",
+)
+def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes, calibration):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
     into notation files in OUTDIR."""
     from fractions import Fraction
@@ -76,6 +92,8 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         effort=not no_effort,
         seed=seed,
         flip_test=flip_test,
+        axes=axes,
+        calibration=calibration,
     )
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "

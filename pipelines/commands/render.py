@@ -48,7 +48,7 @@ def _fps(value: float) -> float:
     "outdir",
     required=True,
     type=click.Path(file_okay=False, path_type=str),
-    help="Folder to write video.mp4, truth.npz and score.lab into.",
+    help="Folder to write video.mp4, truth.npz, camera.toml and score.lab into.",
 )
 @click.option("--fps", type=FPS, default=25.0, show_default=True, help="Frames per second.")
 @click.option("--size", default="640x480", show_default=True, help="Image WIDTHxHEIGHT in pixels.")
@@ -97,5 +97,5 @@ def render(score, outdir, fps, size, view, style, emotion, png, audio):
     )
     sound = "" if audio is None else (", with a click track" if audio == "click" else f", with the sound of {audio}")
     click.echo(
-        f"{out}: {video}, truth.npz and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps{sound})"
+        f"{out}: {video}, truth.npz, camera.toml and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps{sound})"
     )

@@ -6,6 +6,9 @@
   rounded arms (bend 1), tempo 64 and the happy Effort of Neagle's Table 5.1.
 * ``leg_phrase`` — plié, rise and relevé on both feet, a weight transfer, free
   leg gestures (bent and straight), a closing and a step forward.
+* ``turn_and_jump`` — a sauté (jump) from a plié, a slow quarter turn on both
+  feet, a half pirouette in relevé, a closing and a step: the fidelity
+  study's turning and jumping phrase.
 
 The files are read through the one front door
 :func:`capture2notation.notation.read`, so they double as format examples.
@@ -21,7 +24,7 @@ from capture2notation.notation import Score, read
 __all__ = ["PHRASE_NAMES", "builtin_phrases", "phrase", "phrase_path"]
 
 #: Names of the built-in phrases (file stems).
-PHRASE_NAMES: tuple[str, ...] = ("figure7", "port_de_bras", "leg_phrase")
+PHRASE_NAMES: tuple[str, ...] = ("figure7", "port_de_bras", "leg_phrase", "turn_and_jump")
 
 
 def phrase_path(name: str) -> Path:

@@ -16,6 +16,7 @@ import numpy as np
 
 from capture2notation.body import JOINTS, Body, joint_index, rotation_front
 from capture2notation.errors import SyntheticError
+from capture2notation.io.calibration import Calibration, CameraCalibration, camera_name, write_calibration
 from capture2notation.io.truth import write_truth
 
 from .camera import VIEWS, Camera
@@ -25,7 +26,17 @@ from .scene import Pose, landmark_visibility
 from .stick import Stick
 from .video import open_writer
 
-__all__ = ["STYLES", "make_renderer", "render_frames", "render_motion", "render_pose", "render_score", "truth_fields"]
+__all__ = [
+    "CAMERA_FILE",
+    "STYLES",
+    "make_renderer",
+    "render_frames",
+    "render_motion",
+    "render_pose",
+    "render_score",
+    "truth_fields",
+    "write_camera_toml",
+]
 
 #: Rendering styles by name.
 STYLES = {"mannequin": Mannequin, "stick": Stick, "markers": Markers}
@@ -91,7 +102,7 @@ def render_pose(
     progress: bool = False,
     camera: Camera | None = None,
 ) -> Path:
-    """Render `pose` into `outdir`: the frames and their ``truth.npz``.
+    """Render `pose` into `outdir`: the frames, their ``truth.npz`` and ``camera.toml``.
 
     Parameters
     ----------
@@ -131,7 +142,22 @@ def render_pose(
         for i in frames:
             writer.write(renderer.frame(i))
     write_truth(outdir / "truth.npz", **fields)
+    write_camera_toml(camera, outdir / CAMERA_FILE, name=camera_name(outdir.resolve()))
     return video
+
+
+#: The render's camera as a calibration file, beside its video: an experiment
+#: passes it explicitly (``c2n capture VIDEO --calibration OUT/camera.toml``);
+#: a capture never reads it on its own (DESIGN.md, "What a capture may know").
+CAMERA_FILE = "camera.toml"
+
+
+def write_camera_toml(camera: Camera, path, name: str) -> Path:
+    """Write `camera` as a one-camera calibration file named `name` (no distortion)."""
+    cam = CameraCalibration(
+        name, tuple(int(v) for v in camera.size), np.asarray(camera.K), np.zeros(5), camera.R, camera.t
+    )
+    return write_calibration(Calibration.of([cam]), path, comment="the renderer's true camera")
 
 
 def render_motion(motion, outdir, **kw) -> Path:

@@ -61,7 +61,7 @@ def test_render_writes_video_truth_and_score(tmp_path, score_file):
         ],
     )
     assert res.exit_code == 0, res.output
-    assert sorted(p.name for p in out.iterdir()) == ["score.lab", "truth.npz", "video.mp4"]
+    assert sorted(p.name for p in out.iterdir()) == ["camera.toml", "score.lab", "truth.npz", "video.mp4"]
     truth = read_truth(out / "truth.npz")
     n, shape = _frames(out / "video.mp4")
     # 2 beats at 240 bpm = 0.5 s at 10 fps: frames 0…5.
@@ -108,7 +108,7 @@ def test_render_png_frames_match_the_truth(tmp_path, score_file):
         main, ["render", str(score_file), "-o", str(out), "--fps", "4", "--size", "64x48", "--png"]
     )
     assert res.exit_code == 0, res.output
-    assert sorted(p.name for p in out.iterdir()) == ["frames", "score.lab", "truth.npz"]
+    assert sorted(p.name for p in out.iterdir()) == ["camera.toml", "frames", "score.lab", "truth.npz"]
     frames = sorted((out / "frames").iterdir())
     assert len(frames) == read_truth(out / "truth.npz").n_frames == 3
     assert cv2.imread(str(frames[0])).shape == (48, 64, 3)

@@ -1,0 +1,208 @@
+"""Turns, flight, travel and the body key in the capture (issue 14 item 3): the figures.
+
+Run ``python benchmarks/bench_turns.py [--seeds 30] [--video N] [--skip-bvh]``.
+
+Printed (never asserted):
+
+* **Truth round trip**: random scores with turns (1/8 to 2 turns, both
+  ways), springs, travel and the body key (``random_score(...,
+  turns=True, springs=True, travel=True, axes="body")``, fresh seeds
+  20260000+i, 8 beats), the dancer's own joints quantised with the tempo
+  given: exact scores, turns and flights written right, spring forms seen.
+* **Kinect** (``../shared/fixtures/kinect/joints.csv``): agreement of our
+  per-frame upper-arm and forearm labels with LabanotationSuite's
+  (``joints.labanotationsuite_labels.json``), body key and standard key.
+* **Fixture BVH**: the pelvis's total rotation and the turns written (sum
+  of amounts); frames with both (smoothed) feet off the floor and the
+  flights written.
+* ``--video N``: N random scores with turns (and springs) rendered front,
+  640×480, 25 fps, captured from the video (BlazePose, no camera, tempo
+  given): each written turn matched to a captured one overlapping it (amount
+  within 1/8, direction), each flight ≥ 0.3 s matched to a captured flight.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import tempfile
+import time
+import warnings
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+FIXTURES = Path(__file__).resolve().parents[2] / "shared" / "fixtures"
+if not FIXTURES.is_dir():
+    FIXTURES = Path("/work/shared/fixtures")
+
+
+def round_trip(n: int, seed0: int = 20260000) -> None:
+    import synthetic.random_scores as rs
+    from capture2notation.compare.agreement import compare_scores, score_differences
+    from capture2notation.notation.facing import springs
+    from capture2notation.quantise.segment import segment_motion
+    from synthetic.interpret import interpret
+
+    exact, agree = 0, []
+    turns_ok = turns_all = flights_ok = flights_all = 0
+    forms: collections.Counter = collections.Counter()
+    amounts = []
+    t0 = time.perf_counter()
+    for i in range(n):
+        score = rs.random_score(
+            np.random.default_rng(seed0 + i), n_beats=8, turns=True, springs=True, travel=True, axes="body"
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            seg = segment_motion(interpret(score, fps=25.0).joints(), 25.0, tempo=score.tempo, axes=score.axes)
+        d = score_differences(score, seg.score)
+        exact += not d
+        agree.append(compare_scores(score, seg.score).symbol_agreement)
+        got = set(seg.score.symbols)
+        for s in score.symbols:
+            if s.is_turn:
+                turns_all += 1
+                turns_ok += s in got
+                amounts.append(s.signed_amount)
+            if s.is_air:
+                flights_all += 1
+                flights_ok += s in got
+        for _, form in springs(score):
+            forms[form] += 1
+        if d:
+            print(f"  seed {seed0 + i}: {len(d)} differences, e.g. {d[:2]}")
+    print(
+        f"truth round trip, {n} scores (turns, springs, travel, body key), tempo given: "
+        f"{exact}/{n} exact, mean agreement {np.mean(agree):.3f}; "
+        f"turns written exactly {turns_ok}/{turns_all} (amounts {min(amounts)}..{max(amounts)}), "
+        f"flights {flights_ok}/{flights_all}; spring forms drawn {dict(forms)}; {time.perf_counter() - t0:.0f} s"
+    )
+
+
+def kinect() -> None:
+    from capture2notation.fitting.motion import joints_for_labels, read_motion
+    from capture2notation.notation.model import LEVELS
+    from capture2notation.quantise.labels import DIRECTION_NAMES, label_frames
+
+    path = FIXTURES / "kinect" / "joints.csv"
+    m = read_motion(path)
+    ref = json.loads((FIXTURES / "kinect" / "joints.labanotationsuite_labels.json").read_text())["frames"]
+    ts = np.array([r["timestamp"] for r in ref], float) * 1e-7
+    ts -= ts[0]
+    mt = np.asarray(m.times, float) - float(m.times[0])
+    rows = [int(np.argmin(np.abs(mt - t))) for t in ts]
+    for name, joints in (("measured arms", joints_for_labels(m)), ("retargeted fit", m.joints)):
+        for axes in ("body", "standard"):
+            L = label_frames(joints, m.fps, axes=axes)
+            per: collections.Counter = collections.Counter()
+            frames_all = 0
+            for row, f in zip(ref, rows):
+                all_ok = True
+                for side in ("right", "left"):
+                    for seg, part in (("elbow", "upper_arm"), ("wrist", "forearm")):
+                        p = L.index(f"{side}_{part}")
+                        ours = (DIRECTION_NAMES[L.direction[f, p]].replace("_", ""), LEVELS[L.level[f, p]])
+                        d, lv = row[f"{side} {seg}"]
+                        theirs = (
+                            d.lower().replace(" ", "").replace("backward", "back"),
+                            {"normal": "middle"}.get(lv.lower(), lv.lower()),
+                        )
+                        ok = ours == theirs
+                        per[f"{side}_{part}"] += ok
+                        all_ok &= ok
+                frames_all += all_ok
+            n = len(ref)
+            segs = ", ".join(f"{k} {v / n:.1%}" for k, v in sorted(per.items()))
+            print(f"kinect {name}, {axes} key: all four segments agree on {frames_all / n:.1%} of {n} frames ({segs})")
+
+
+def bvh() -> None:
+    from capture2notation.fitting.motion import joints_for_labels, read_motion
+    from capture2notation.quantise.flight import find_flights
+    from capture2notation.quantise.segment import segment_motion
+    from capture2notation.quantise.supports import smooth_positions
+    from capture2notation.quantise.turns import continuous_front
+
+    for path in sorted((FIXTURES / "bvh").glob("*.bvh")):
+        m = read_motion(path)
+        joints = joints_for_labels(m)
+        front = continuous_front(joints)
+        ok = np.isfinite(front)
+        net = float(front[ok][-1] - front[ok][0])
+        total = float(np.nansum(np.abs(np.diff(front))))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            seg = segment_motion(joints, m.fps)
+        turns = [s for s in seg.score.symbols if s.is_turn]
+        written = float(sum(s.signed_amount for s in turns)) * 360
+        flights = [s for s in seg.score.symbols if s.is_air]
+        off = find_flights(smooth_positions(joints, m.fps), m.fps, measured=True)
+        print(
+            f"{path.name}: {len(m.times)} frames at {m.fps:.0f} fps; pelvis net rotation {net:+.0f}°, "
+            f"path {total:.0f}°; turns written {len(turns)} totalling {written:+.0f}° "
+            f"({', '.join(f'{s.direction} {s.amount}' for s in turns[:12])}); "
+            f"airborne runs ≥ 0.2 s (smoothed feet, ballistic pelvis) {len(off)}, flights written {len(flights)}"
+        )
+
+
+def video(n: int, seed0: int = 20261400) -> None:
+    import synthetic.random_scores as rs
+    from capture2notation.compare.agreement import compare_scores
+    from pipelines.capture import capture
+    from synthetic.render import render_score
+
+    turns_ok = turns_all = flights_ok = flights_all = 0
+    for i in range(n):
+        score = rs.random_score(np.random.default_rng(seed0 + i), n_beats=8, turns=True, springs=True)
+        with tempfile.TemporaryDirectory() as tmp:
+            work = Path(tmp)
+            t0 = time.perf_counter()
+            render = render_score(
+                score, work / "render", fps=25.0, size=(640, 480), view="front", style="mannequin", progress=False
+            )
+            cap = capture(
+                render / "video.mp4", work / "video", progress=False, effort=False, overlay=False, tempo=score.tempo
+            )
+            got = cap.score
+            for s in score.symbols:
+                if s.is_turn:
+                    turns_all += 1
+                    match = [c for c in got.symbols if c.is_turn and c.start < s.end and s.start < c.end]
+                    hit = any(c.direction == s.direction and abs(c.amount - s.amount) <= Fraction(1, 8) for c in match)
+                    turns_ok += hit
+                if s.is_air and float(s.duration) * 60 / float(score.tempo) >= 0.3:
+                    flights_all += 1
+                    flights_ok += any(c.is_air and c.start <= s.end and s.start <= c.end for c in got.symbols)
+            a = compare_scores(score, got)
+            print(
+                f"  video seed {seed0 + i}: agreement {a.symbol_agreement:.3f}, turns written "
+                f"{[(s.direction, str(s.amount)) for s in score.symbols if s.is_turn]} captured "
+                f"{[(s.direction, str(s.amount)) for s in got.symbols if s.is_turn]}, "
+                f"flights {sum(s.is_air for s in score.symbols)} -> {sum(s.is_air for s in got.symbols)}, "
+                f"{time.perf_counter() - t0:.0f} s"
+            )
+    print(
+        f"video ({n} scores, front, 640x480, 25 fps, BlazePose, tempo given): turns within 1/8 and the right way "
+        f"{turns_ok}/{turns_all}; flights >= 0.3 s found {flights_ok}/{flights_all}"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=30)
+    ap.add_argument("--video", type=int, default=0, help="random scores to render and capture from video")
+    ap.add_argument("--skip-bvh", action="store_true")
+    args = ap.parse_args()
+    round_trip(args.seeds)
+    kinect()
+    if not args.skip_bvh:
+        bvh()
+    if args.video:
+        video(args.video)
+
+
+if __name__ == "__main__":
+    main()

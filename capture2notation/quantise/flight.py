@@ -1,0 +1,228 @@
+"""Flight: ``support air`` where both feet leave the floor, and the landing after it.
+
+DESIGN.md ("Facing and turns", the ``.lab`` extension for ``support air``)
+and ``docs/benchmarks/turns.md`` fix what is written:
+
+* ``support air`` runs from the **take-off** frame (the last frame with a
+  foot on the floor) to the **touchdown** frame (the first with one again);
+  no foot is on the floor strictly between.
+* The **landing** support starts at touchdown and ends where the pelvis
+  comes to rest (a local minimum of its speed; at a frame of the beat grid
+  for clean motion); its part is the feet on the floor at touchdown, its
+  level the one held there (``low`` for a plié), its direction the landing
+  feet's displacement from where they took off — a foot that was
+  gesturing at take-off from beside the take-off foot, at the hips' width —
+  in the body frame at take-off, ``place`` under half a step.
+* The support before the flight arrives at the take-off frame.
+* Spring forms are not written: they follow from the supports before and
+  after (:func:`capture2notation.notation.facing.spring_form`).
+
+The supports' own segmentation (:mod:`.supports`) reads the floor; this
+module rewrites its movements around each flight found.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..body import body_frame, joint_index
+from ..notation.directions import classify_indices
+from ..notation.model import AIR, LEVELS
+from .labels import DIRECTION_NAMES, SUPPORT_HEIGHT_M, FrameLabels, foot_points
+from .movement import Movement
+from .supports import STEP_MIN_FRACTION, _step_direction, support_state
+
+__all__ = ["find_flights", "with_flights"]
+
+#: Shortest flight of clean motion, frames: one frame clear of the floor.
+_MIN_CLEAN_FRAMES = 1
+#: Shortest flight of measured motion, seconds: a jump of 5 cm of foot
+#: clearance lasts 0.2 s; shorter gaps are contact flicker of a fit.
+MIN_MEASURED_FLIGHT_S = 0.2
+#: Longest landing, seconds: a landing comes to rest within two beats at 60 bpm.
+_MAX_LANDING_S = 2.0
+#: A landing comes to rest at a pelvis speed minimum below this fraction of
+#: its speed since touchdown (the plié's dip slows it to ~0.2 of it).
+_REST_FRACTION = 0.1
+#: Gravity, m/s².
+GRAVITY_MS2 = 9.81
+#: A flight's pelvis accelerates downwards by at least this fraction of g on
+#: average (a ballistic pelvis: 1; a walk's pelvis: near 0 either way).
+BALLISTIC_FRACTION = 0.5
+_SUPPORT_PARTS = ("support", "right_support", "left_support")
+
+
+def find_flights(joints: np.ndarray, fps: float, measured: bool, floor: float = 0.0) -> list[tuple[int, int]]:
+    """``(take_off, touchdown)`` frames of every flight.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        World joints, metres, z up (smoothed for measured motion).
+    fps : float
+    measured : bool
+        Fitted or recorded motion: flights must last :data:`MIN_MEASURED_FLIGHT_S`.
+    floor : float
+        Floor height, metres.
+
+    Returns
+    -------
+    list of (int, int)
+        Frames; only flights with a foot on the floor before and after.
+    """
+    low, _ = foot_points(np.asarray(joints, float))
+    # Both feet clear of the floor (a missing foot counts as unknown: no flight).
+    air = np.all(np.stack([lo - floor >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
+    edges = np.flatnonzero(np.diff(np.r_[0, air.astype(int), 0]))
+    shortest = max(_MIN_CLEAN_FRAMES, int(np.ceil(MIN_MEASURED_FLIGHT_S * fps))) if measured else _MIN_CLEAN_FRAMES
+    out = []
+    for a, b in zip(edges[::2], edges[1::2]):
+        if a == 0 or b >= air.size or b - a < shortest:
+            continue
+        t0, t1 = int(a - 1), int(b)
+        if not _ballistic(joints, t0, t1, fps):
+            continue
+        out.append((t0, t1))
+    return out
+
+
+def _ballistic(joints: np.ndarray, t0: int, t1: int, fps: float) -> bool:
+    """Whether the pelvis falls freely between take-off `t0` and touchdown `t1`.
+
+    Both feet can clear the floor's 3 cm for a frame or two in a quick step
+    (the back foot's toe lifts as the front foot lands); the pelvis then
+    moves smoothly.  In flight it decelerates upwards and falls: its mean
+    vertical acceleration is near −g.
+    """
+    z = joints[t0 : t1 + 1, joint_index("pelvis"), 2]
+    if z.size < 3 or not np.isfinite(z).all():
+        return True
+    v = np.diff(z) * fps
+    acc = (v[-1] - v[0]) / ((v.size - 1) / fps)
+    return bool(acc <= -BALLISTIC_FRACTION * GRAVITY_MS2)
+
+
+def _rest_frame(joints: np.ndarray, t1: int, fps: float, on_grid: np.ndarray | None) -> int:
+    """First frame after touchdown `t1` where the pelvis comes to rest (a speed minimum)."""
+    p = joints[:, joint_index("pelvis")]
+    s = np.linalg.norm(np.diff(p, axis=0), axis=-1) * fps  # interval i: frames i → i+1
+    T = p.shape[0]
+    last = min(T - 1, t1 + int(round(_MAX_LANDING_S * fps)))
+    peak = 0.0
+    for f in range(t1 + 1, last + 1):
+        m = f - 1  # the interval arriving at f
+        if m + 1 >= s.size:
+            return T - 1
+        peak = max(peak, float(s[m]))
+        # A deep minimum: the dip of a plié absorbing the landing slows the
+        # pelvis too, but only to a fifth of its touchdown speed.
+        deep = s[m + 1] <= _REST_FRACTION * peak
+        if s[m + 1] <= 1e-9 or (deep and s[m] >= s[m + 1] <= s[min(m + 2, s.size - 1)]):
+            g = f + 1 if s[m + 1] > 1e-9 else f
+            for cand in (g, g - 1, g + 1):
+                if t1 < cand < T and (on_grid is None or on_grid[cand]):
+                    return cand
+    return last
+
+
+def _landing_direction(joints: np.ndarray, t0: int, t1: int, feet: tuple[int, ...], height: float) -> str:
+    """Where the landing feet came down relative to where they took off, in the body frame at take-off."""
+    _, mids = foot_points(joints)
+    low, _ = foot_points(joints)
+    frame = body_frame(joints[t0 : t0 + 1])[0]
+    on_floor = [bool(lo[t0] < SUPPORT_HEIGHT_M + 1e-9) for lo in low]
+    hips = joints[t0, joint_index("right_hip")] - joints[t0, joint_index("left_hip")]
+    width = float(np.hypot(hips[0], hips[1]))
+    shifts = []
+    for k in feet:
+        if on_floor[k]:
+            start = mids[k][t0]
+        else:
+            # A gesturing foot lands beside the take-off foot, at the hips' width.
+            other = 1 - k
+            side = 1.0 if k == 0 else -1.0  # right foot to the right
+            start = mids[other][t0] + side * width * frame[0]
+        shifts.append(mids[k][t1] - start)
+    d = np.mean(shifts, axis=0)
+    d[2] = 0.0
+    if not np.linalg.norm(d) >= STEP_MIN_FRACTION * height:
+        return "place"
+    idx, _ = classify_indices((frame @ d)[None])
+    name = DIRECTION_NAMES[int(idx[0])]
+    return "place" if name == "place" else name
+
+
+def with_flights(
+    moves: list[Movement],
+    labels: FrameLabels,
+    joints: np.ndarray,
+    fps: float,
+    flights: list[tuple[int, int]],
+    height: float,
+    on_grid: np.ndarray | None = None,
+) -> list[Movement]:
+    """Support movements rewritten around each flight (see the module docstring).
+
+    Parameters
+    ----------
+    moves : list of Movement
+        Support movements (:func:`~.supports.support_movements`).
+    labels : FrameLabels
+        Their per-frame labels (feet contacts and levels).
+    joints : (T, J, 3) ndarray
+    fps : float
+    flights : list of (int, int)
+        :func:`find_flights`.
+    height : float
+        Body height, metres (a step is measured in heights).
+    on_grid : (T,) ndarray of bool, optional
+        Clean motion: the landing comes to rest on a grid frame.
+
+    Returns
+    -------
+    list of Movement
+        In time order.
+    """
+    if not flights:
+        return moves
+    part, level = support_state(labels, joints)
+    low, _ = foot_points(joints)
+    out = list(moves)
+    for t0, t1 in flights:
+        rest = _rest_frame(joints, t1, fps, on_grid)
+        kept = []
+        for m in out:
+            if m.end_frame <= t0 or m.start_frame >= rest:
+                kept.append(m)
+            elif m.start_frame < t0:
+                # Arrives at the take-off: the state held there.
+                p, lv = int(part[t0]), int(level[t0])
+                if p >= 0:
+                    step = _step_direction(joints, labels, m.start_frame, t0, p, height)
+                    kept.append(
+                        Movement(_SUPPORT_PARTS[p], m.start_frame, t0, m.start_time, t0 / fps, step, LEVELS[lv])
+                    )
+            elif m.end_frame > rest:
+                kept.append(
+                    Movement(m.part, rest, m.end_frame, rest / fps, m.end_time, m.direction, m.level, m.bend, m.amount)
+                )
+        feet = tuple(k for k in (0, 1) if low[k][t1] < SUPPORT_HEIGHT_M)
+        if not feet:
+            out = kept
+            continue
+        landing_part = "support" if len(feet) == 2 else ("right_support", "left_support")[feet[0]]
+        lv = int(level[rest]) if level[rest] >= 0 else int(np.max(labels.support_level[t1]))
+        direction = _landing_direction(joints, t0, t1, feet, height)
+        kept.append(Movement("support", t0, t1, t0 / fps, t1 / fps, AIR, ""))
+        kept.append(Movement(landing_part, t1, rest, t1 / fps, rest / fps, direction, LEVELS[max(lv, 0)]))
+        out = kept
+    out.sort(key=lambda m: m.start_frame)
+    # A support identical to the one just before it is no movement.
+    deduped: list[Movement] = []
+    for m in out:
+        prev = deduped[-1] if deduped else None
+        same = prev is not None and (prev.part, prev.level, prev.direction) == (m.part, m.level, m.direction)
+        if same and m.direction == "place":
+            continue
+        deduped.append(m)
+    return deduped

@@ -1,0 +1,136 @@
+"""Turns and the score's key in the capture: the front over time, turn symbols, body-keyed labels."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import synthetic.random_scores as random_scores
+from capture2notation.body import body_frame, front_of, joint_index
+from capture2notation.compare.agreement import score_differences
+from capture2notation.notation.model import Score, Symbol
+from capture2notation.quantise.segment import segment_motion
+from capture2notation.quantise.turns import continuous_front, turn_movements
+from synthetic.interpret import interpret
+
+FPS = 25.0
+
+
+def _turn_score(turns, tempo=60, axes="standard"):
+    """Stand on both feet and turn slowly: `turns` is ``(start, duration, direction, amount)``."""
+    syms = [
+        Symbol(Fraction(s), Fraction(d), "turn", direction, None, amount=Fraction(a)) for s, d, direction, a in turns
+    ]
+    end = max(s + d for s, d, *_ in turns)
+    syms.append(Symbol(Fraction(end), Fraction(1), "right_arm", "forward", "middle"))
+    return Score(symbols=tuple(syms), tempo=Fraction(tempo), axes=axes)
+
+
+def test_continuous_front_folds_mirrored_hips_back():
+    # A body seen from the wrong side has its hips mirrored: the raw front
+    # jumps by 180°; the continuous front must follow the real turn.
+    score = _turn_score([(0, 4, "right", "1/2")])
+    motion = interpret(score, fps=FPS)
+    joints = motion.joints()
+    truth = motion.front
+    mirrored = joints.copy()
+    r, l = joint_index("right_hip"), joint_index("left_hip")
+    frames = slice(40, 70)  # part way through the turn and after
+    mirrored[frames, r], mirrored[frames, l] = joints[frames, l], joints[frames, r]
+    raw = front_of(body_frame(mirrored)[:, 1])
+    assert np.max(np.abs(raw - truth)) > 150.0  # the flip is there
+    got = continuous_front(mirrored)
+    np.testing.assert_allclose(got - got[0], truth - truth[0], atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "turns",
+    [
+        [(0, 2, "right", "1/8")],
+        [(0, 4, "left", "1/2")],
+        [(0, 2, "right", "1/4"), (2, 2, "left", "1/4")],
+    ],
+)
+def test_clean_turns_come_back_with_amount_direction_and_span(turns):
+    score = _turn_score(turns)
+    joints = interpret(score, fps=FPS).joints()
+    got = turn_movements(joints, FPS, measured=False, on_grid=np.ones(joints.shape[0], bool))
+    want = [(round(s * FPS), round((s + d) * FPS), direction, Fraction(a)) for s, d, direction, a in turns]
+    assert [(m.start_frame, m.end_frame, m.direction, m.amount) for m in got] == want
+
+
+def test_measured_turn_is_found_through_jitter():
+    score = _turn_score([(0, 2, "right", "1/2")])
+    joints = interpret(score, fps=FPS).joints()
+    rng = np.random.default_rng(3)
+    noisy = joints + rng.normal(0.0, 0.01, joints.shape)  # 1 cm per coordinate
+    got = turn_movements(noisy, FPS, measured=True)
+    assert [(m.direction, m.amount) for m in got] == [("right", Fraction(1, 2))]
+    # Start and arrival within a few frames of the written span (0 to 50).
+    assert abs(got[0].start_frame - 0) <= 5 and abs(got[0].end_frame - 50) <= 5
+
+
+def test_no_turn_is_written_for_a_dancer_who_does_not_turn():
+    score = Score(symbols=(Symbol(Fraction(0), Fraction(2), "right_arm", "right", "high"),), tempo=Fraction(60))
+    joints = interpret(score, fps=FPS).joints()
+    assert turn_movements(joints, FPS, measured=False) == []
+
+
+def test_body_keyed_random_scores_round_trip_exactly():
+    rng = np.random.default_rng(1414)
+    for _ in range(3):
+        score = random_scores.random_score(rng, n_beats=8, axes="body")
+        seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo, axes="body")
+        assert seg.score.axes == "body"
+        assert score_differences(score, seg.score) == []
+
+
+def test_written_turns_round_trip_on_two_feet():
+    score = _turn_score([(0, 2, "right", "1/4"), (3, 2, "left", "3/8")], tempo=90)
+    seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
+    assert score_differences(score, seg.score) == []
+
+
+def test_kinect_body_key_reproduces_labanotationsuite_labels(fixture_path):
+    """LabanotationSuite's per-frame arm labels (an independent reference) from ``--axes body``."""
+    import json
+
+    from capture2notation.fitting.motion import joints_for_labels, read_motion
+    from capture2notation.notation.model import LEVELS
+    from capture2notation.quantise.labels import DIRECTION_NAMES, label_frames
+
+    motion = read_motion(fixture_path("kinect/joints.csv"))
+    ref = json.loads(fixture_path("kinect/joints.labanotationsuite_labels.json").read_text())["frames"]
+    ticks = np.array([r["timestamp"] for r in ref], float) * 1e-7
+    rows = [int(np.argmin(np.abs((motion.times - motion.times[0]) - (t - ticks[0])))) for t in ticks]
+    agree = {}
+    for axes in ("body", "standard"):
+        lab = label_frames(joints_for_labels(motion), motion.fps, axes=axes)
+        same = []
+        for r, f in zip(ref, rows):
+            for side in ("right", "left"):
+                for seg, part in (("elbow", "upper_arm"), ("wrist", "forearm")):
+                    p = lab.index(f"{side}_{part}")
+                    d, lv = r[f"{side} {seg}"]
+                    theirs = (
+                        d.lower().replace(" ", "").replace("backward", "back"),
+                        lv.lower().replace("normal", "middle"),
+                    )
+                    same.append(
+                        (DIRECTION_NAMES[lab.direction[f, p]].replace("_", ""), LEVELS[lab.level[f, p]]) == theirs
+                    )
+        agree[axes] = float(np.mean(same))
+    assert agree["body"] >= 0.97
+    # The standard key reads the arms against gravity, not the leaning torso.
+    assert agree["standard"] < 0.9
+
+
+def test_turn_and_jump_phrase_captures_exactly_with_estimated_tempo():
+    import synthetic.phrases as phrases
+
+    score = phrases.phrase("turn_and_jump")
+    seg = segment_motion(interpret(score, fps=FPS).joints(), FPS)
+    assert seg.tempo == score.tempo
+    assert score_differences(score, seg.score) == []
