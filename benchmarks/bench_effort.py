@@ -16,9 +16,15 @@ Wall-clock and CPU times are both printed: the machine may be shared.
 ``--white`` times the independent-residual likelihood instead of the
 default AR(1) one (the figures before the AR(1) model).
 
+4. With ``--scale``: the Effort step of phrases of ``--lengths`` seconds
+   at each of ``--fps``, each in its own process: CPU seconds, peak RSS,
+   CPU per posterior (linear in the length and flat in the frame rate is
+   the aim).
+
 Usage::
 
     /work/venv/bin/python benchmarks/bench_effort.py [--n 20] [--workers 2] [--capture DIR] [--white]
+    /work/venv/bin/python benchmarks/bench_effort.py --scale --lengths 30 60 120 --fps 25 120
 """
 
 from __future__ import annotations
@@ -175,13 +181,71 @@ def bench_capture(folder: str, seed: int = 0) -> None:
     )
 
 
+def _phrase(seconds: int, seed: int = 1, tempo: int = 60) -> Score:
+    """Both arms moving throughout `seconds` at `tempo` (1–2 beat symbols)."""
+    rng = np.random.default_rng(seed)
+    beats = seconds * tempo // 60
+    syms = []
+    for part in ("right_arm", "left_arm"):
+        syms += [s for s in random_arm_score(rng, beats, tempo=tempo, part=part).symbols if s.end <= beats]
+    return Score(symbols=tuple(syms), tempo=Fraction(tempo), effort=Effort(time=-2.42, weight=0.6, space=0.0))
+
+
+def bench_one(seconds: int, fps: float, seed: int = 1) -> None:
+    """One phrase's Effort step (child process of :func:`bench_scale`): prints CPU s, peak RSS, posteriors."""
+    score = _phrase(seconds, seed)
+    joints = interpret(score, fps=fps).joints() if interpret is not None else arc_motion(score, fps)
+    joints = joints + 0.005 * np.random.default_rng(seed).standard_normal(joints.shape)
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    c0, w0 = time.process_time(), time.perf_counter()
+    res = estimate_effort(joints, None, fps, score, rng=seed)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    n_post = len(res.movements) + len(res.parts) + (res.pooled is not None)
+    conv = sum(m.posterior.converged for m in res.movements)
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    print(
+        f"RESULT {seconds} {fps} {cpu:.2f} {wall:.2f} {rss / 1024:.0f} {rss0 / 1024:.0f} {n_post} {conv} {len(res.movements)}"
+    )
+
+
+def bench_scale(lengths, fps_list) -> None:
+    """Effort step CPU time and peak memory against the phrase's length and frame rate (one process each)."""
+    import subprocess
+    import sys
+
+    print("== Effort step against length and frame rate (each in its own process; CPU s: the machine is shared) ==")
+    print("  length  fps  CPU s  wall s  peak RSS MB (before Effort)  posteriors  CPU ms/posterior  converged")
+    for fps in fps_list:
+        for seconds in lengths:
+            out = subprocess.run(
+                [sys.executable, __file__, "--one", str(seconds), str(fps)], capture_output=True, text=True, check=True
+            ).stdout
+            line = [ln for ln in out.splitlines() if ln.startswith("RESULT")][-1].split()
+            _, sec, f, cpu, wall, rss, rss0, n_post, conv, n_mov = line
+            print(
+                f"  {sec:>5} s {float(f):4.0f}  {float(cpu):5.1f}  {float(wall):6.1f}  {rss:>6} ({rss0})"
+                f"  {n_post:>10}  {1000 * float(cpu) / int(n_post):9.0f}  {conv}/{n_mov}",
+                flush=True,
+            )
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=20, help="Movement posteriors to time.")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--capture", help="A capture folder (capture.npz + score.lab) to time the Effort step on.")
     ap.add_argument("--white", action="store_true", help="Independent residuals instead of AR(1).")
+    ap.add_argument("--scale", action="store_true", help="Effort step against length (--lengths) and --fps.")
+    ap.add_argument("--lengths", type=int, nargs="+", default=[30, 60, 120], help="Phrase lengths, seconds.")
+    ap.add_argument("--fps", type=float, nargs="+", default=[25.0], help="Frame rates for --scale.")
+    ap.add_argument("--one", nargs=2, type=float, metavar=("SECONDS", "FPS"), help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.one:
+        bench_one(int(a.one[0]), a.one[1])
+        return
+    if a.scale:
+        bench_scale(a.lengths, a.fps)
+        return
     print(
         f"dancer: {'synthetic.interpret' if interpret is not None else 'reference arcs'}; "
         f"residuals: {'white' if a.white else 'AR(1)'}; load average {os.getloadavg()[0]:.1f} (2 cores, shared)"

@@ -49,6 +49,7 @@ __all__ = [
     "START_FRACTION",
     "ProgressCurve",
     "limb_reach",
+    "part_constants",
     "progress_curve",
     "refine_window",
 ]
@@ -239,6 +240,7 @@ def refine_window(
     joint_names=JOINTS,
     moving: float = MOVING_FRACTION,
     max_extend: float = MAX_EXTEND,
+    noise: float | None = None,
 ) -> tuple:
     """Move a movement window's edges outward to where the extremity really starts and stops.
 
@@ -294,6 +296,10 @@ def refine_window(
         Fraction of the peak speed above which an end is moved outward.
     max_extend : float
         Largest move of each edge, as a fraction of ``t_end − t_start``.
+    noise : float, optional
+        The jitter speed floor, rad/s (:func:`part_constants`), when the
+        arrays are a slice of a longer clip: the floor is the whole clip's.
+        Default: estimated from the given frames.
 
     Returns
     -------
@@ -317,7 +323,8 @@ def refine_window(
     u = np.nan_to_num(rel) / np.where(norm > 1e-6, norm, 1.0)[:, None]
     speed = _interval_speed(u, good, times)  # (T-1,), interval k = [times[k], times[k+1]]
     dt = float(np.median(np.diff(times)))
-    noise = _speed_noise(u, good, dt)
+    if noise is None:
+        noise = _speed_noise(u, good, dt)
     tol = 1e-6 * dt
     # the nearest frames inside the window (the edges themselves when snapped)
     i0 = int(np.searchsorted(times, t_start - tol))
@@ -390,6 +397,7 @@ def progress_curve(
     joint_names=JOINTS,
     method: str = "circle",
     snap: float = SNAP_S,
+    reach: float | None = None,
 ) -> ProgressCurve | None:
     """Progress curve of `part` over the window [t_start, t_end] seconds.
 
@@ -416,6 +424,10 @@ def progress_curve(
         movement's key frames (``synthetic.interpret.beat_frame``); other
         ends (e.g. in decimated captures) are extrapolated from the nearest
         frames inside the window.  0 disables snapping.
+    reach : float, optional
+        The straight limb's length, metres (:func:`part_constants`), when
+        the arrays are a slice of a longer clip.  Default: measured on the
+        given frames (:func:`limb_reach`).
 
     Returns
     -------
@@ -484,7 +496,9 @@ def progress_curve(
     outward = None
     middle = names.index(PART_MIDDLE_JOINT[part]) if PART_MIDDLE_JOINT.get(part) in names else -1
     if middle >= 0:
-        reach = REACH_MARGIN * limb_reach(joints, ok, bound, middle, free)
+        if reach is None:
+            reach = limb_reach(joints, ok, bound, middle, free)
+        reach = REACH_MARGIN * reach
         # a limb already straight at both ends (or an unmeasured reach) has
         # no outward room: depth 0, and Space is read from inward pulls only
         outward = np.maximum(np.nan_to_num(reach / r_direct[1:-1] - 1.0, nan=0.0), 0.0)
@@ -499,3 +513,44 @@ def progress_curve(
         angle=total,
         outward=outward,
     )
+
+
+def part_constants(joints, confidence, times, part: str, joint_names=JOINTS) -> tuple:
+    """Whole-clip quantities of one part that its movements share: (jitter speed floor, limb reach).
+
+    :func:`refine_window` and :func:`progress_curve` read them from the
+    arrays they are given; computed once here, every movement can be
+    measured on a slice of frames around its own window, so measuring M
+    movements of a T-frame clip costs O(T), not O(M·T).
+
+    Returns
+    -------
+    noise : float or None
+        :func:`_speed_noise` over the whole clip, rad/s (None: part unknown).
+    reach : float or None
+        :func:`limb_reach`, metres (None for parts without a middle joint).
+    """
+    names = list(joint_names)
+    if part not in PART_SEGMENTS or not all(j in names for j in PART_SEGMENTS[part]):
+        return None, None
+    bound, free = (names.index(j) for j in PART_SEGMENTS[part])
+    joints = np.asarray(joints, dtype=float)
+    times = np.asarray(times, dtype=float)
+    rel = joints[:, free] - joints[:, bound]
+    fin = np.all(np.isfinite(rel), axis=1)
+    if confidence is None:
+        conf = np.ones(times.shape[0])
+    else:
+        c = np.nan_to_num(np.asarray(confidence, dtype=float), nan=0.0)
+        conf = np.minimum(c[:, free], c[:, bound])
+    norm = np.linalg.norm(np.nan_to_num(rel), axis=1)
+    good = fin & (conf > 0) & (norm > 1e-6)
+    noise = None
+    if times.size >= 3 and good.sum() >= 3:
+        u = np.nan_to_num(rel) / np.where(norm > 1e-6, norm, 1.0)[:, None]
+        noise = _speed_noise(u, good, float(np.median(np.diff(times))))
+    reach = None
+    middle = names.index(PART_MIDDLE_JOINT[part]) if PART_MIDDLE_JOINT.get(part) in names else -1
+    if middle >= 0:
+        reach = limb_reach(joints, good, bound, middle, free)
+    return noise, reach

@@ -16,7 +16,7 @@ import numpy as np
 from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS, Score
-from .curves import SNAP_S, ProgressCurve, _snap, progress_curve, refine_window
+from .curves import MAX_EXTEND, SNAP_S, ProgressCurve, _snap, part_constants, progress_curve, refine_window
 from .domain import EmotionDomain, emotion_domain
 from .emotion import SPREAD, emotion_probabilities, features
 from .fit import SpaceEstimate
@@ -172,6 +172,11 @@ def movement_windows(score: Score, times: np.ndarray) -> list:
     return out
 
 
+#: Frames kept beyond a movement's reach on each side when it is measured
+#: on a slice of the clip (the end points use the two nearest frames, within
+#: 2.5 frame steps).
+_SLICE_PAD = 4
+
 #: Posteriors sampled together in one vectorised emcee run (a fixed size, so
 #: results do not depend on the number of worker processes).
 CHUNK = 24
@@ -275,6 +280,7 @@ def estimate_effort(
     kw = dict(sampler_kw or {})
 
     curves, syms, skipped = [], [], []
+    constants: dict = {}
     windows = movement_windows(score, times)
     limits = _neighbour_bounds(windows)
     for (sym, t0, t1), lim in zip(windows, limits):
@@ -282,13 +288,25 @@ def estimate_effort(
         if t0 < times[0] or t1 > times[-1] + 0.5 / fps:
             skipped.append({**where, "reason": f"window {t0:.3f}-{t1:.3f} s outside the capture"})
             continue
+        if sym.part not in constants:
+            constants[sym.part] = part_constants(joints, confidence, times, sym.part, joint_names)
+        noise, reach = constants[sym.part]
+        # the frames this movement can touch: its window, as far as the
+        # refinement may move each edge, and a few frames beyond for the
+        # end-point extrapolation (whole-clip arrays per movement made the
+        # step grow with the square of the clip's length)
+        ext = MAX_EXTEND * max(t1 - t0, 0.0) + 2 * snap
+        a = max(int(np.searchsorted(times, t0 - ext)) - _SLICE_PAD, 0)
+        z = int(np.searchsorted(times, t1 + ext)) + _SLICE_PAD
+        jt, tt = joints[a:z], times[a:z]
+        cf = None if confidence is None else confidence[a:z]
         if refine:
             if snap > 0:
-                t0, t1 = _snap(t0, times, snap), _snap(t1, times, snap)
+                t0, t1 = _snap(t0, tt, snap), _snap(t1, tt, snap)
             if t1 > t0:
-                t0, t1 = refine_window(joints, confidence, times, sym.part, t0, t1, lim, joint_names)
+                t0, t1 = refine_window(jt, cf, tt, sym.part, t0, t1, lim, joint_names, noise=noise)
         try:
-            c = progress_curve(joints, confidence, times, sym.part, t0, t1, joint_names, snap=snap)
+            c = progress_curve(jt, cf, tt, sym.part, t0, t1, joint_names, snap=snap, reach=reach)
         except EffortError as exc:
             skipped.append({**where, "reason": str(exc)})
             continue

@@ -277,61 +277,94 @@ def fit_logistic_many(datasets, iterations: int = 60, sd_floor_sigma: float = 1e
 _RHO_GRID = np.linspace(-0.5, 0.99, 60)
 
 
-def _ar1_regression(tau, x, y, w, column: int):
-    """Posterior mean and sd of one coefficient of ``y = x β + ε`` with AR(1) residuals.
+#: Largest (ρ values × samples) work array of :func:`_ar1_regression`,
+#: elements (about 16 MB per float array, whatever the phrase's length).
+_RHO_CHUNK_ELEMENTS = 1 << 21
 
-    ``√w_i ε_i`` is AR(1) along each run of increasing τ, with correlation
-    ``ρ^(Δτ/δ)`` between neighbours (δ the median step), σ unknown (prior
-    1/σ) and β flat; ρ is marginalised over :data:`_RHO_GRID` (uniform
-    prior): a mixture of the per-ρ Student posteriors, summarised by its
-    mean and standard deviation.
+
+def _seg_sum(key, u, v, k: int, n_seg: int) -> np.ndarray:
+    """Σ of u·v over each (ρ, movement) pair: (k, N) inputs -> (k, n_seg)."""
+    return np.bincount(key, (u * v).ravel(), k * n_seg).reshape(k, n_seg)
+
+
+def _through_line(zz, det, p1, p2, q1, q2) -> np.ndarray:
+    """Σ over movements of pᵀ (ZᵀZ)⁻¹ q with ZᵀZ = [[zz0, zz1], [zz1, zz2]] per (ρ, movement): (k,)."""
+    s11, s12, s22 = zz
+    return np.sum((p1 * (s22 * q1 - s12 * q2) + p2 * (s11 * q2 - s12 * q1)) / det, axis=1)
+
+
+def _ar1_regression(tau, a, y, w, groups=None):
+    """Posterior mean and sd of β in ``y = β·a + c_g + d_g·τ + ε`` with AR(1) residuals.
+
+    ``√w_i ε_i`` is AR(1) along each run of increasing τ within a movement,
+    with correlation ``ρ^(Δτ/δ)`` between neighbours (δ the median step),
+    σ unknown (prior 1/σ) and β, c_g, d_g flat; ρ is marginalised over
+    :data:`_RHO_GRID` (uniform prior): a mixture of the per-ρ Student
+    posteriors, summarised by its mean and standard deviation.
+
+    Each movement's straight line (c_g, d_g) touches only its own samples
+    and the AR(1) chain restarts at each movement, so the normal equations
+    are block-diagonal but for β: the lines are eliminated movement by
+    movement (2×2 Schur complements), which keeps time and memory linear in
+    the number of samples — a dense design with two columns per movement
+    grew with the square of the phrase's length (3.7 GB for a 240-s phrase).
 
     Parameters
     ----------
-    tau, y, w : (N,) ndarray
-    x : (N, P) ndarray
-        Design matrix.
-    column : int
-        The coefficient reported.
+    tau, a, y, w : (N,) ndarray
+        Normalised time, the regressor of β, the response and the weights.
+    groups : (N,) ndarray of int, optional
+        Movement of each sample (default: one movement).
 
     Returns
     -------
     mean, sd : float
     """
-    n, p = x.shape
+    n = tau.size
+    seg = np.zeros(n, dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1].ravel()
+    n_seg = int(seg.max()) + 1
     step = np.diff(tau, prepend=-np.inf)
-    first = step <= 0
-    first[0] = True
+    first = (step <= 0) | np.r_[True, seg[1:] != seg[:-1]]
     delta = np.median(step[~first]) if np.any(~first) else 1.0
     expo = np.where(first, 0.0, step / delta)
-    rho = _RHO_GRID[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):  # first frames are replaced below
-        phi = np.exp(expo[None, :] * np.log(np.abs(rho)))
-    phi = np.where(first[None, :], 0.0, np.where((rho < 0) & (np.round(expo) % 2 == 1), -phi, phi))  # (K, N)
-    c = 1.0 / np.sqrt(1.0 - phi * phi)
+    odd = np.round(expo) % 2 == 1
     sw = np.sqrt(w)
-    xw, yw = x * sw[:, None], y * sw
-
-    def whiten(v):  # (N, ...) -> (K, N, ...): each row minus φ times the one before
-        prev = np.roll(v, 1, axis=0)
-        shape = (slice(None), slice(None)) + (None,) * (v.ndim - 1)
-        return c[shape] * (v[None] - phi[shape] * prev[None])
-
-    xt, yt = whiten(xw), whiten(yw)
-    gram = np.einsum("kni,knj->kij", xt, xt)
-    coef = np.linalg.solve(gram, np.einsum("kni,kn->ki", xt, yt)[..., None])[..., 0]
-    rss = np.maximum(np.sum((yt - np.einsum("kni,ki->kn", xt, coef)) ** 2, axis=1), 1e-300)
-    dof = max(n - p, 1)
-    _, logdet = np.linalg.slogdet(gram)
-    # log p(y | ρ) with β and ln σ integrated out, up to a constant
-    logp = -0.5 * logdet - 0.5 * dof * np.log(rss) - 0.5 * np.sum(np.log(1.0 - phi * phi), axis=1)
-    post = np.exp(logp - logp.max())
+    cols = np.stack([sw, sw * tau, sw * a, sw * y])  # (4, N): line's two, β's, response
+    prev = np.roll(cols, 1, axis=1)
+    dof = max(n - 1 - 2 * n_seg, 1)
+    chunk = max(1, _RHO_CHUNK_ELEMENTS // max(n, 1))
+    logp, mean_k, var_k = [], [], []
+    for r0 in range(0, _RHO_GRID.size, chunk):
+        rho = _RHO_GRID[r0 : r0 + chunk, None]
+        k = rho.shape[0]
+        with np.errstate(divide="ignore", invalid="ignore"):  # first frames are replaced below
+            phi = np.exp(expo[None, :] * np.log(np.abs(rho)))
+        phi = np.where(first[None, :], 0.0, np.where((rho < 0) & odd[None, :], -phi, phi))  # (k, N)
+        one_m_phi2 = 1.0 - phi * phi
+        c = 1.0 / np.sqrt(one_m_phi2)
+        z = c[:, None] * (cols[None] - phi[:, None] * prev[None])  # (k, 4, N), whitened
+        key = (np.arange(k)[:, None] * n_seg + seg[None, :]).ravel()
+        z1, z2, za, zy = z[:, 0], z[:, 1], z[:, 2], z[:, 3]
+        zz = [_seg_sum(key, u, v, k, n_seg) for u, v in ((z1, z1), (z1, z2), (z2, z2))]
+        u_a, v_a = _seg_sum(key, z1, za, k, n_seg), _seg_sum(key, z2, za, k, n_seg)
+        u_y, v_y = _seg_sum(key, z1, zy, k, n_seg), _seg_sum(key, z2, zy, k, n_seg)
+        det = zz[0] * zz[2] - zz[1] * zz[1]
+        aa = np.sum(za * za, axis=1) - _through_line(zz, det, u_a, v_a, u_a, v_a)
+        ay = np.sum(za * zy, axis=1) - _through_line(zz, det, u_a, v_a, u_y, v_y)
+        yy = np.sum(zy * zy, axis=1) - _through_line(zz, det, u_y, v_y, u_y, v_y)
+        coef = ay / aa
+        rss = np.maximum(yy - ay * coef, 1e-300)
+        logdet = np.sum(np.log(det), axis=1) + np.log(aa)
+        # log p(y | ρ) with the coefficients and ln σ integrated out, up to a constant
+        logp.append(-0.5 * logdet - 0.5 * dof * np.log(rss) - 0.5 * np.sum(np.log(one_m_phi2), axis=1))
+        mean_k.append(coef)
+        # the Student posterior's variance (dof > 2), else the Gaussian's
+        var_k.append(rss / dof / aa * (dof / (dof - 2.0) if dof > 2 else 1.0))
+    lp, mk, vk = np.concatenate(logp), np.concatenate(mean_k), np.concatenate(var_k)
+    post = np.exp(lp - lp.max())
     post /= post.sum()
-    mean_k = coef[:, column]
-    # the Student posterior's variance (dof > 2), else the Gaussian's
-    var_k = rss / dof * np.linalg.inv(gram)[:, column, column] * (dof / (dof - 2.0) if dof > 2 else 1.0)
-    mean = float(post @ mean_k)
-    return mean, float(np.sqrt(post @ (var_k + (mean_k - mean) ** 2)))
+    mean = float(post @ mk)
+    return mean, float(np.sqrt(post @ (vk + (mk - mean) ** 2)))
 
 
 def fit_space(tau, radial, weight=None, outward=None, groups=None) -> SpaceEstimate:
@@ -369,16 +402,12 @@ def fit_space(tau, radial, weight=None, outward=None, groups=None) -> SpaceEstim
     if tau.size < 4:
         raise EffortError(f"need at least 4 samples to fit Space, got {tau.size}")
     bump = np.sin(np.pi * tau)
-    if groups is None:
-        line = np.column_stack([np.ones_like(tau), tau])
-    else:
+    g = None
+    if groups is not None:
         g = np.asarray(groups)
         if g.shape != tau.shape:
             raise EffortError(f"groups must be shaped like tau {tau.shape}, got {g.shape}")
-        onehot = (g[:, None] == np.unique(g)[None, :]).astype(float)  # (N, G)
-        line = np.hstack([onehot, onehot * tau[:, None]])
-    x = np.column_stack([bump, line])
-    amp, se = _ar1_regression(tau, x, y, w, 0)
+    amp, se = _ar1_regression(tau, bump, y, w, g)
     # floor: the dancer's own modulation is resolved to ~1e-3 of the radius
     # (S to 0.01); a noise-free render would otherwise give a zero-width interval
     se = float(max(se, 1e-3))
@@ -389,8 +418,7 @@ def fit_space(tau, radial, weight=None, outward=None, groups=None) -> SpaceEstim
         if depth.shape != tau.shape or not np.all(np.isfinite(depth)):
             raise EffortError(f"outward depth must be finite and shaped like tau {tau.shape}, got {depth.shape}")
     if clear_out and depth is not None and np.average(depth * bump, weights=w) > MIN_OUTWARD_DEPTH:
-        x[:, 0] = depth * bump
-        k, k_se = _ar1_regression(tau, x, y, w, 0)
+        k, k_se = _ar1_regression(tau, depth * bump, y, w, g)
         # same floor as below: S resolved to 0.01
         mu, sd = 1.0 - k, float(max(k_se, 1e-3 / INWARD_DEPTH))
     else:
