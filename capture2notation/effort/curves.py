@@ -38,6 +38,7 @@ from ..notation.model import PART_MIDDLE_JOINT, PART_SEGMENTS
 
 __all__ = [
     "END_DROP",
+    "MAX_CURVE_POINTS",
     "MAX_EXTEND",
     "MIN_ANGLE_DEG",
     "MIN_FRAMES",
@@ -52,6 +53,7 @@ __all__ = [
     "part_constants",
     "progress_curve",
     "refine_window",
+    "resample_curve",
 ]
 
 #: A movement whose direction turns by less than this is "held" (no curve).
@@ -554,3 +556,60 @@ def part_constants(joints, confidence, times, part: str, joint_names=JOINTS) -> 
     if middle >= 0:
         reach = limb_reach(joints, good, bound, middle, free)
     return noise, reach
+
+
+#: Largest number of samples a movement's curve keeps (:func:`resample_curve`):
+#: the posterior's cost is proportional to it, so capping it makes Effort's
+#: cost independent of the frame rate.  48 keeps every 25-fps movement of up
+#: to two beats at 60 bpm (≤ 49 interior frames) as measured.
+MAX_CURVE_POINTS = 48
+
+
+def resample_curve(curve: ProgressCurve, n_points: int = MAX_CURVE_POINTS) -> ProgressCurve:
+    """The curve averaged into at most `n_points` equal bins of τ (unchanged when it has no more samples).
+
+    Each bin holds the confidence-weighted means of its frames' τ, progress,
+    radial and outward deviation, and the sum of their confidences divided
+    by the fullest bin's frame count (a bin of k white-noise frames is worth
+    k of them; weights stay in (0, 1]).  The likelihood's AR(1) correlation
+    ρ is per median sample step (:class:`.likelihood.Batch`), so after
+    resampling it is the correlation between neighbouring bins: the model
+    follows the new spacing without a change.  Empty bins (lost frames) are
+    left out, and the AR(1) chain then spans the gap as it does a gap of
+    frames.
+
+    Parameters
+    ----------
+    curve : ProgressCurve
+    n_points : int
+        Most samples kept (≥ 4, :data:`MIN_FRAMES`).
+
+    Returns
+    -------
+    ProgressCurve
+    """
+    if n_points < MIN_FRAMES:
+        raise EffortError(f"a curve needs at least {MIN_FRAMES} points, got n_points={n_points}")
+    if curve.tau.size <= n_points:
+        return curve
+    # which bin of [0, 1] each τ falls in: τ ∈ (0, 1), so every index is in range
+    k = np.minimum((curve.tau * n_points).astype(int), n_points - 1)
+    count = np.bincount(k, minlength=n_points)
+    w = curve.weight
+    wsum = np.bincount(k, w, n_points)
+    full = count > 0
+
+    def mean(v):
+        return (np.bincount(k, w * v, n_points) / np.where(full, wsum, 1.0))[full]
+
+    return ProgressCurve(
+        part=curve.part,
+        t_start=curve.t_start,
+        t_end=curve.t_end,
+        tau=mean(curve.tau),
+        s=mean(curve.s),
+        weight=wsum[full] / count.max(),
+        radial=mean(curve.radial),
+        angle=curve.angle,
+        outward=None if curve.outward is None else mean(curve.outward),
+    )

@@ -16,7 +16,17 @@ import numpy as np
 from ..body import JOINTS
 from ..errors import EffortError
 from ..notation.model import PART_SEGMENTS, Score
-from .curves import MAX_EXTEND, SNAP_S, ProgressCurve, _snap, part_constants, progress_curve, refine_window
+from .curves import (
+    MAX_CURVE_POINTS,
+    MAX_EXTEND,
+    SNAP_S,
+    ProgressCurve,
+    _snap,
+    part_constants,
+    progress_curve,
+    refine_window,
+    resample_curve,
+)
 from .domain import EmotionDomain, emotion_domain
 from .emotion import SPREAD, emotion_probabilities, features
 from .fit import SpaceEstimate
@@ -118,6 +128,10 @@ def _effort_fields(post: Posterior, space: SpaceEstimate) -> dict:
         "tau": float(np.max(post.tau)),
         "acceptance": post.acceptance,
         "converged": post.converged,
+        # why sampling ended: "converged", "gave up" (its τ asked for more
+        # steps than the budget) or "budget" (ran out of steps)
+        "sampler_stop": post.stop,
+        "steps": post.steps,
     }
     if post.rho is not None:
         # frame-to-frame correlation of the progress residuals (AR(1) model):
@@ -224,6 +238,7 @@ def estimate_effort(
     per_movement: bool = True,
     snap: float = SNAP_S,
     refine: bool = True,
+    max_points: int = MAX_CURVE_POINTS,
 ) -> EffortResult:
     """Estimate Laban Effort per movement, pooled per part and phrase, and the emotion.
 
@@ -261,6 +276,11 @@ def estimate_effort(
         middle of the neighbouring movements of the same part.  Windows of a
         clean render are left unchanged; those of a captured score are often
         cut short by a fraction of a beat.
+    max_points : int
+        Most samples per movement's curve: longer curves (high frame rates,
+        slow movements) are averaged into this many bins of τ
+        (:func:`.curves.resample_curve`), so the cost does not grow with the
+        frame rate.
 
     Returns
     -------
@@ -313,7 +333,8 @@ def estimate_effort(
         if c is None:
             skipped.append({**where, "reason": "part held (turns less than 5 degrees)"})
             continue
-        curves.append(c)
+        # a fixed number of samples per movement: cost independent of the frame rate
+        curves.append(resample_curve(c, max_points))
         syms.append(sym)
     for sk in skipped:
         log.info("effort: skipped %s at beat %s: %s", sk["part"], sk["start"], sk["reason"])

@@ -81,6 +81,9 @@ class Posterior:
     rho : (M,) ndarray or None
         Samples of the residuals' frame-to-frame correlation ρ, row by row
         with `samples` (None for white residuals).
+    stop : {"converged", "gave up", "budget"}
+        Why sampling ended (:class:`.sampler.Chain`): "gave up" when the
+        τ estimate asked for more steps than ``max_steps`` allows.
     """
 
     samples: np.ndarray
@@ -90,6 +93,7 @@ class Posterior:
     steps: int
     start: np.ndarray
     rho: np.ndarray | None = None
+    stop: str = "converged"
 
     def summary(self, column: int) -> dict:
         """``{"median": m, "ci90": [lo, hi]}`` of one parameter column."""
@@ -241,7 +245,7 @@ def sample_posteriors(
     out = []
     for g, ch in enumerate(chains):
         if not ch.converged:
-            log.info("emcee did not converge in %d steps (tau = %s)", ch.steps, np.round(ch.tau, 1))
+            log.info("emcee did not converge in %d steps (%s; tau = %s)", ch.steps, ch.stop, np.round(ch.tau, 1))
         th = ch.samples()
         lns = batch.draw_log_sigma(g, th, rng)
         out.append(
@@ -253,6 +257,7 @@ def sample_posteriors(
                 steps=ch.steps,
                 start=start3[g],
                 rho=th[:, 2] if ar1 else None,
+                stop=ch.stop,
             )
         )
     return out

@@ -11,7 +11,12 @@ for every walker of every group.
 
 Convergence is judged per group with emcee's integrated autocorrelation
 time (its ``autocorr.integrated_time`` estimator, vectorised over groups by
-:func:`integrated_time`): checked every ``block`` steps, a group is done
+:func:`integrated_time`).  The estimate costs a whole-chain FFT, so it is
+not redone every block: after each estimate a group is next checked when
+its chain reaches :data:`CHECK_AHEAD` × N_TAU × τ (then block by block), and
+a group whose τ asks for more than the step budget after
+:data:`GIVE_UP_MIN_STEPS` steps is given up (reported as such).  Chains are
+kept in preallocated arrays grown by doubling.  A group is done
 when its chain is longer than :data:`N_TAU` τ and τ moved by less than
 ``tau_rtol`` since the last check (emcee's "Saving & monitoring progress"
 tutorial uses 100 τ and 1 %; its autocorrelation tutorial calls 50 τ
@@ -30,10 +35,29 @@ import numpy as np
 from ..errors import EffortError
 from .likelihood import Batch
 
-__all__ = ["N_TAU", "Chain", "GroupedDEMove", "integrated_time", "run_groups"]
+__all__ = [
+    "CHECK_AHEAD",
+    "GIVE_UP_FACTOR",
+    "GIVE_UP_MIN_STEPS",
+    "N_TAU",
+    "Chain",
+    "GroupedDEMove",
+    "integrated_time",
+    "run_groups",
+]
 
 #: Chain length required, in autocorrelation times (emcee docs: ≥ 50 τ).
 N_TAU = 50
+#: A group's τ is next estimated once its chain reaches this fraction of
+#: N_TAU times the last estimate (τ grows as the chain explores, and a check
+#: too late only costs a block): most checks need no FFT at all.
+CHECK_AHEAD = 0.8
+#: Give up on a posterior whose chain needs more than this many times the
+#: step budget by its current τ estimate ...
+GIVE_UP_FACTOR = 1.0
+#: ... once it has run at least this many steps (shorter chains' τ
+#: estimates are too noisy to act on).
+GIVE_UP_MIN_STEPS = 1000
 #: Largest FFT work array of :func:`integrated_time`, elements.
 _FFT_CHUNK = 1 << 22
 
@@ -150,12 +174,17 @@ class Chain:
     acceptance : float
         Mean acceptance fraction of the group's walkers.
     converged : bool
+    stop : {"converged", "gave up", "budget"}
+        Why sampling ended: converged; given up early because even the
+        (low-biased) τ estimate asked for more than the budget; the budget
+        ran out.
     """
 
     chain: np.ndarray
     tau: np.ndarray
     acceptance: float
     converged: bool
+    stop: str = "converged"
 
     @property
     def steps(self) -> int:
@@ -235,9 +264,10 @@ def run_groups(
         logp = batch.log_marginal(coords)
     random = np.random.RandomState(int(rng.integers(2**32)))
     active = list(range(G))
-    pieces: dict[int, list] = {g: [] for g in active}
+    store = {g: np.empty((min(4 * block, max_steps), W, D)) for g in active}  # grown by doubling
     accepted = np.zeros(G)
     old_tau = np.full((G, D), np.inf)
+    next_check = np.full(G, block)  # step count at which each group's τ is next estimated
     result: dict[int, Chain] = {}
     steps = 0
     while active:
@@ -253,26 +283,48 @@ def run_groups(
         sampler.random_state = random.get_state()
         state = sampler.run_mcmc(emcee.State(coords, log_prob=logp), run, progress=False, skip_initial_state_check=True)
         random.set_state(sampler.random_state)
-        steps += run
         blk = sampler.get_chain().reshape(run, n_a, W, D)
         acc = sampler.backend.accepted.reshape(n_a, W).sum(axis=1)
         for j, g in enumerate(active):
-            pieces[g].append(blk[:, j])
+            if store[g].shape[0] < steps + run:
+                grown = np.empty((min(2 * store[g].shape[0], max_steps), W, D))
+                grown[:steps] = store[g][:steps]
+                store[g] = grown
+            store[g][steps : steps + run] = blk[:, j]
             accepted[g] += acc[j]
-        chains = np.stack([np.concatenate(pieces[g]) for g in active], axis=1)  # (steps, n_a, W, D)
-        tau = integrated_time(chains)
-        with np.errstate(invalid="ignore"):
-            ok = (
-                np.all(np.isfinite(tau), axis=1)
-                & (steps >= N_TAU * np.max(tau, axis=1))
-                & np.all(np.abs(old_tau[active] - tau) / tau < tau_rtol, axis=1)
-            )
-        finished = ok | (steps >= max_steps)
-        for j in np.flatnonzero(finished):
-            g = active[j]
-            result[g] = Chain(chains[:, j], tau[j], float(accepted[g] / (steps * W)), bool(ok[j]))
-            del pieces[g]
-        old_tau[active] = tau
+        steps += run
+        at_end = steps >= max_steps
+        # τ (a whole-chain FFT) only for groups that may have converged by
+        # now, judged from their last estimate, and at the budget's end
+        due = [j for j, g in enumerate(active) if at_end or steps >= next_check[g]]
+        finished = np.zeros(n_a, dtype=bool)
+        if due:
+            tau = integrated_time(np.stack([store[active[j]][:steps] for j in due], axis=1))
+            for i, j in enumerate(due):
+                g, t = active[j], tau[i]
+                with np.errstate(invalid="ignore"):
+                    ok = bool(
+                        np.all(np.isfinite(t))
+                        and steps >= N_TAU * np.max(t)
+                        and np.all(np.abs(old_tau[g] - t) / t < tau_rtol)
+                    )
+                need = N_TAU * float(np.max(t)) if np.all(np.isfinite(t)) else np.inf
+                # τ estimates of short chains are biased low, so a need that
+                # exceeds the budget even so will not be met: stop now
+                give_up = not ok and steps >= GIVE_UP_MIN_STEPS and need > GIVE_UP_FACTOR * max_steps
+                if ok or give_up or at_end:
+                    stop = "converged" if ok else ("gave up" if give_up else "budget")
+                    result[g] = Chain(store[g][:steps].copy(), t, float(accepted[g] / (steps * W)), ok, stop)
+                    del store[g]
+                    finished[j] = True
+                old_tau[g] = t
+                # next estimate: the next block when the chain is long enough
+                # already (τ must also be stable), else once it nears 50 τ
+                next_check[g] = (
+                    steps + block
+                    if steps >= CHECK_AHEAD * need
+                    else max(steps + block, int(CHECK_AHEAD * need) // block * block)
+                )
         keep = np.flatnonzero(~finished)
         coords = state.coords.reshape(n_a, W, D)[keep].reshape(-1, D)
         logp = state.log_prob.reshape(n_a, W)[keep].ravel()
