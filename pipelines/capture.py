@@ -53,8 +53,9 @@ from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
 from capture2notation.errors import C2NError, PipelineError, QuantiseError
 from capture2notation.fitting.motion import joints_for_labels
-from capture2notation.notation.model import Score
+from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW, Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
+from capture2notation.quantise.confidence import score_confidence
 from capture2notation.quantise.labels import write_labels_csv
 from capture2notation.quantise.segment import (
     Segmentation,
@@ -347,6 +348,8 @@ def capture(
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
+    conf = getattr(motion, "confidence", None)
+    seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf))
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
     log.info("capture: tempo %s bpm%s", seg.tempo, how)
@@ -570,15 +573,27 @@ def _effort_html(files: dict) -> str:
 <div>{plots}</div>"""
 
 
+UNCERTAIN_ROW = ' class="uncertain"'
+
+
+def _confidence_cell(s) -> str:
+    if s.confidence is None:
+        return ""
+    return f"{s.confidence:.2f}" + (" uncertain" if s.uncertain else "")
+
+
 def index_html(result: CaptureResult) -> str:
     """A self-contained page: the staff beside the overlay video, the symbols and the files."""
     score = result.score
     rows = "\n".join(
-        f"<tr><td>{s.start}</td><td>{s.duration}</td><td>{html.escape(s.part)}</td>"
+        f"<tr{UNCERTAIN_ROW if s.uncertain else ''}><td>{s.start}</td>"
+        f"<td>{score.seconds(s.start):.2f}</td><td>{s.duration}</td><td>{html.escape(s.part)}</td>"
         f"<td>{html.escape(s.direction)}</td><td>{html.escape(s.level or '')}</td>"
-        f"<td>{s.bend or (f'amount={s.amount}' if s.amount is not None else '')}</td></tr>"
+        f"<td>{s.bend or (f'amount={s.amount}' if s.amount is not None else '')}</td>"
+        f"<td>{_confidence_cell(s)}</td></tr>"
         for s in score.symbols
     )
+    n_uncertain = sum(s.uncertain for s in score.symbols)
     video = (
         '<video src="overlay.mp4" controls loop muted playsinline width="100%"></video>'
         if "overlay.mp4" in result.files
@@ -609,6 +624,7 @@ body {{ font-family: sans-serif; margin: 1.5em; }}
 .staff {{ flex: 0 0 auto; max-height: 90vh; overflow-y: auto; }}
 .video {{ flex: 1 1 480px; max-width: 720px; }}
 table {{ border-collapse: collapse; }} td, th {{ padding: 0.1em 0.6em; border-bottom: 1px solid #ddd; }}
+tr.uncertain td {{ color: #777; font-style: italic; }}
 </style></head><body>
 <h1>Capture: {html.escape(score.title)}</h1>
 <p>{result.n_frames} frames at {float(result.motion.fps):g} fps · input: {html.escape(result.kind)} ·
@@ -618,13 +634,16 @@ tempo {html.escape(tempo)} · meter {score.meter} · {len(score.symbols)} symbol
 <div class="staff"><img src="staff.svg" alt="Labanotation staff of the captured score"></div>
 <div class="video">{video}
 <h2>Symbols</h2>
-<table><tr><th>start</th><th>duration</th><th>part</th><th>direction</th><th>level</th><th>bend</th></tr>
+<p class="uncertain-count">{n_uncertain} of {len(score.symbols)} symbols uncertain (confidence below
+{SYMBOL_UNCERTAIN_BELOW:g}; grey and dashed on the staff).</p>
+<table><tr><th>start (beat)</th><th>start (s)</th><th>duration</th><th>part</th><th>direction</th><th>level</th>
+<th>bend</th><th>confidence</th></tr>
 {rows}
 </table></div></div>
 {effort}
 <h2>Files</h2><p>{links}</p>
 {"<h2>Not written</h2><ul>" + skipped + "</ul>" if skipped else ""}
 <p>Time: {html.escape(timing)}</p>
-<script type="application/json" id="summary">{html.escape(json.dumps({"tempo": str(score.tempo), "symbols": len(score.symbols)}))}</script>
+<script type="application/json" id="summary">{html.escape(json.dumps({"tempo": str(score.tempo), "symbols": len(score.symbols), "uncertain": n_uncertain}))}</script>
 </body></html>
 """

@@ -2,7 +2,9 @@
 
 Both back ends draw the same geometry: outlines filled by level (hatched
 high, a dot for middle, black low), turn pins and amounts, spring forms in
-flight gaps, bend marks, and the front signs beside the staff.
+flight gaps, bend marks, and the front signs beside the staff.  An
+uncertain symbol (:attr:`~capture2notation.notation.model.Symbol.uncertain`)
+is drawn in grey with a dashed outline, so it reads as a guess at a glance.
 """
 
 from __future__ import annotations
@@ -14,14 +16,20 @@ import numpy as np
 
 from .staff_layout import FrontSign, Glyph, StaffLayout
 
-__all__ = ["render_png", "svg_text"]
+__all__ = ["UNCERTAIN_GREY", "render_png", "svg_text"]
+
+#: Ink of an uncertain symbol (black for the others).
+UNCERTAIN_GREY = "#8c8c8c"
+#: Dash pattern of an uncertain symbol's outline, pixels on / off.
+UNCERTAIN_DASH = (4.0, 2.5)
 
 
 def _hatch_pattern() -> str:
-    return (
-        '<pattern id="hatch" patternUnits="userSpaceOnUse" width="6" height="6" '
+    return "".join(
+        f'<pattern id="{name}" patternUnits="userSpaceOnUse" width="6" height="6" '
         'patternTransform="rotate(45)"><rect width="6" height="6" fill="white"/>'
-        '<line x1="0" y1="0" x2="0" y2="6" stroke="black" stroke-width="1.6"/></pattern>'
+        f'<line x1="0" y1="0" x2="0" y2="6" stroke="{ink}" stroke-width="1.6"/></pattern>'
+        for name, ink in (("hatch", "black"), ("hatch-uncertain", UNCERTAIN_GREY))
     )
 
 
@@ -42,9 +50,13 @@ def _pin_end(cx: float, cy: float, deg: float, r: float) -> tuple[float, float]:
 def _glyph_svg(g: Glyph) -> str:
     s = g.symbol
     level = s.level or "none"
-    fill = {"high": "url(#hatch)", "middle": "white", "low": "black", "none": "white"}[level]
+    ink = UNCERTAIN_GREY if s.uncertain else "black"
+    hatch = "url(#hatch-uncertain)" if s.uncertain else "url(#hatch)"
+    fill = {"high": hatch, "middle": "white", "low": ink, "none": "white"}[level]
+    dash = f' stroke-dasharray="{UNCERTAIN_DASH[0]:g} {UNCERTAIN_DASH[1]:g}"' if s.uncertain else ""
+    certainty = " uncertain" if s.uncertain else ""
     attrs = (
-        f'id="sym-{g.index}" class="symbol part-{s.part} dir-{s.direction} level-{level}" '
+        f'id="sym-{g.index}" class="symbol part-{s.part} dir-{s.direction} level-{level}{certainty}" '
         f'data-part="{s.part}" data-direction="{s.direction}" data-level="{s.level or ""}" '
         f'data-bend="{s.bend}" data-start="{s.start}" data-duration="{s.duration}"'
     )
@@ -52,18 +64,22 @@ def _glyph_svg(g: Glyph) -> str:
         attrs += f' data-amount="{s.amount}"'
     if s.is_air:
         attrs += f' data-spring="{g.label}"'
+    if s.confidence is not None:
+        attrs += f' data-confidence="{s.confidence:.3f}"'
     what = f"{s.part} {s.direction} {s.level or ''}".rstrip()
     if s.amount is not None:
         what += f" amount={s.amount}"
     if s.is_air:
         what += f" ({g.label})"
+    if s.confidence is not None:
+        what += f" confidence {s.confidence:.2f}" + (" (uncertain)" if s.uncertain else "")
     out = [f"<g {attrs}>", f"<title>{escape(f'{what} beat {s.start}+{s.duration}')}</title>"]
     for piece in g.pieces:
         pts = " ".join(f"{x:.2f},{y:.2f}" for x, y in piece)
-        out.append(f'<polygon class="outline" points="{pts}" fill="{fill}" stroke="black" stroke-width="1.5"/>')
+        out.append(f'<polygon class="outline" points="{pts}" fill="{fill}" stroke="{ink}" stroke-width="1.5"{dash}/>')
     if s.level == "middle":
         cx, cy = g.centre
-        out.append(f'<circle class="dot" cx="{cx:.2f}" cy="{cy:.2f}" r="{g.dot_radius:.2f}" fill="black"/>')
+        out.append(f'<circle class="dot" cx="{cx:.2f}" cy="{cy:.2f}" r="{g.dot_radius:.2f}" fill="{ink}"/>')
     if g.pin is not None:
         cx, cy = g.centre
         r = 2.2 * g.dot_radius
@@ -173,20 +189,22 @@ def render_png(lay: StaffLayout, path, dpi: int) -> None:
     with matplotlib.rc_context({"hatch.linewidth": 1.2}):
         for g in lay.glyphs:
             s = g.symbol
-            face = {"high": "white", "middle": "white", "low": "black", None: "white"}[s.level]
+            ink = UNCERTAIN_GREY if s.uncertain else "black"
+            face = {"high": "white", "middle": "white", "low": ink, None: "white"}[s.level]
             for piece in g.pieces:
                 ax.add_patch(
                     Polygon(
                         piece,
                         closed=True,
                         facecolor=face,
-                        edgecolor="black",
+                        edgecolor=ink,
                         lw=1.5 * pt,
                         hatch="////" if s.level == "high" else None,
+                        linestyle=(0, UNCERTAIN_DASH) if s.uncertain else "solid",
                     )
                 )
             if s.level == "middle":
-                ax.add_patch(Circle(g.centre, g.dot_radius, color="black"))
+                ax.add_patch(Circle(g.centre, g.dot_radius, color=ink))
             if g.pin is not None:
                 tx, ty = _pin_end(g.centre[0], g.centre[1], g.pin, 2.2 * g.dot_radius)
                 ax.plot([g.centre[0], tx], [g.centre[1], ty], color="black", lw=1.4 * pt)
