@@ -11,7 +11,7 @@ take).  Example ``study.toml``::
     emotions = ["happy", "sad", "angry", "afraid"]
     takes = 3                # test performances per phrase and emotion
     training_takes = 3       # separate performances that calibrate the observer
-    capture = "auto"         # "truth", "keypoints", "video" or "auto"
+    capture = "auto"         # "truth", "keypoints", "video", "auto", or "keypoints-calibrated"/"video-calibrated"
     frame_rates = [25, 12.5, 8.33, 5]
     resampling = ["keyframe", "naive"]
     image_sizes = [[220, 175], [320, 240], [640, 480], [1280, 720]]
@@ -38,7 +38,7 @@ from capture2notation.notation.model import EMOTIONS
 
 __all__ = ["StudyConfig", "load_config", "quick"]
 
-CAPTURES = ("auto", "truth", "keypoints", "video")
+CAPTURES = ("auto", "truth", "keypoints", "video", "keypoints-calibrated", "video-calibrated")
 RESAMPLING = ("keyframe", "naive")
 VIEWS = ("front", "45", "side")
 

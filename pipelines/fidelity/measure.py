@@ -14,15 +14,19 @@ Capture paths (``capture`` in the study config):
     landmarks are missing), jittered and rounded as above, with BlazePose-like
     world landmarks (hip-centred, camera axes, Gaussian noise of
     :data:`WORLD_NOISE_M`), then fitted in 3D by
-    :func:`capture2notation.fitting.fit_keypoints` with the known camera and
-    default body proportions.  Compression is not modelled.
+    :func:`capture2notation.fitting.fit_keypoints` with default body
+    proportions and the camera the fit estimates from the landmarks (what a
+    user without a calibration has).  Compression is not modelled.
 ``video``
     The whole chain: the renderer draws the take
     (:func:`synthetic.render.job.render_score`), the kept frames are held
     in between (Neagle's emulation of a low rate at 25 Hz), JPEG-compressed
     at the condition's quality and given Gaussian pixel noise, and
     :func:`pipelines.capture.capture` (BlazePose, fitting, segmentation)
-    reads the video.  Several seconds of CPU per job.
+    reads the video with no calibration.  Several seconds of CPU per job.
+``keypoints-calibrated``, ``video-calibrated``
+    The same with the renderer's camera given to the fit (as ``c2n capture
+    --calibration camera.toml`` would): the named calibrated condition.
 
 Only the kept frames of a condition reach the capture (the others are
 missing, never invented); the metrics that need a full-rate sequence use the
@@ -124,7 +128,7 @@ def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random
 
     Parameters
     ----------
-    mode : {"truth", "keypoints", "video"}
+    mode : {"truth", "keypoints", "video", "keypoints-calibrated", "video-calibrated"}
     motion : synthetic.motion.Motion
     kept : (M,) ndarray of int
     cond : Condition
@@ -139,6 +143,13 @@ def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random
     confidence : (T, J) ndarray
         In [0, 1], 0 where missing.
     """
+    mode, _, suffix = mode.partition("-")
+    if suffix not in ("", "calibrated") or (suffix and mode == "truth"):
+        raise PipelineError(
+            f"capture path {mode + '-' + suffix!r} is not available; use 'truth', 'keypoints', 'video', "
+            "'keypoints-calibrated' or 'video-calibrated'"
+        )
+    calibrated = suffix == "calibrated"
     truth = motion.joints()
     T, J, _ = truth.shape
     out = np.full((T, J, 3), np.nan)
@@ -168,8 +179,16 @@ def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random
         hip = 0.5 * (lm[:, 23] + lm[:, 24])
         world = (lm - hip[:, None]) @ cam.R.T + rng.normal(0.0, WORLD_NOISE_M, lm.shape)
         world[vis == 0] = np.nan
-        fitcam = FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height))
-        res = fit_keypoints(uv, vis, motion.fps, camera=fitcam, world=world, times=kept / motion.fps)
+        fitcam = FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height)) if calibrated else None
+        res = fit_keypoints(
+            uv,
+            vis,
+            motion.fps,
+            camera=fitcam,
+            world=world,
+            times=kept / motion.fps,
+            image_size=(cond.width, cond.height),
+        )
         # The fitter's skeleton places unseen joints by the body model; keep
         # them (confidence 0 still marks them unmeasured for the Effort fit).
         out[kept] = res.joints
@@ -178,14 +197,14 @@ def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random
     if mode == "video":
         if score is None:
             raise PipelineError("the video capture path needs the take's score to render it")
-        j, c = _capture_video(score, motion, kept, cond, rng)
+        j, c = _capture_video(score, motion, kept, cond, rng, calibrated)
         out[kept], conf[kept] = j[kept], c[kept]
         out[conf == 0] = np.nan
         return out, conf
     raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
 
 
-def _capture_video(score: Score, motion, kept, cond: Condition, rng):
+def _capture_video(score: Score, motion, kept, cond: Condition, rng, calibrated: bool = False):
     """Render, degrade (hold, JPEG, noise) and capture a take; joints (T,J,3) and confidence (T,J)."""
     import tempfile
     from pathlib import Path
@@ -195,7 +214,7 @@ def _capture_video(score: Score, motion, kept, cond: Condition, rng):
     from capture2notation.compare.resample import hold_map
     from capture2notation.io.video import VideoWriter, iter_frames
     from pipelines.capture import capture as run_capture
-    from synthetic.render.job import render_score
+    from synthetic.render.job import CAMERA_FILE, render_score
 
     T = motion.n_frames
     with tempfile.TemporaryDirectory(prefix="c2n-fidelity-") as tmp:
@@ -229,6 +248,7 @@ def _capture_video(score: Score, motion, kept, cond: Condition, rng):
             overlay=False,
             progress=False,
             seed=int(rng.integers(2**31)),
+            calibration=tmp / "render" / CAMERA_FILE if calibrated else None,
         )
         with np.load(tmp / "capture" / "capture.npz") as z:
             joints = np.asarray(z["joints"], float)

@@ -346,11 +346,26 @@ def test_tempo_from_a_click_track(tmp_path):
     """A render with a click track: the sound's beat sets the tempo, and the page says so."""
     pytest.importorskip("librosa")
     video = _clicked_render(tmp_path, tempo=97)
-    res = capture(video, tmp_path / "c", backend="markers", progress=False, effort=False, overlay=False)
+    # The renderer's camera, passed as a user with a calibration would: the
+    # marker figure has no world landmarks to estimate the camera and floor
+    # from, and this test is about the sound, not the floor.
+    cal = video.parent / "camera.toml"
+    res = capture(
+        video, tmp_path / "c", backend="markers", progress=False, effort=False, overlay=False, calibration=cal
+    )
     assert res.score.tempo == 97 and res.segmentation.tempo_source == "the sound track and the movements"
     assert "estimated from the sound track and the movements" in (tmp_path / "c" / "index.html").read_text()
     # --tempo none ignores the sound: one beat a second.
-    none = capture(video, tmp_path / "n", backend="markers", tempo="none", progress=False, effort=False, overlay=False)
+    none = capture(
+        video,
+        tmp_path / "n",
+        backend="markers",
+        tempo="none",
+        progress=False,
+        effort=False,
+        overlay=False,
+        calibration=cal,
+    )
     assert none.score.tempo == 60 and none.segmentation.tempo_source == "none"
 
 
