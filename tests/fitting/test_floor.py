@@ -4,8 +4,9 @@ import numpy as np
 
 from capture2notation.body import JOINTS, Body, joint_index
 from capture2notation.fitting import Camera, FitOptions
-from capture2notation.fitting.fit import _initial_params, _problem
+from capture2notation.fitting.fit import _problem
 from capture2notation.fitting.floor import floor_depth, support_depth
+from capture2notation.fitting.start import initial_params as _initial_params
 
 CAM = Camera.default((640, 480))
 T = 20
