@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from capture2notation.atomic import atomic_path, write_text
-from capture2notation.body import JOINTS
+from capture2notation.body import JOINTS, joint_index
 from capture2notation.errors import C2NError, PipelineError, QuantiseError
 from capture2notation.fitting.motion import joints_for_labels
 from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW, Score
@@ -173,6 +173,7 @@ def load_motion(
     progress: bool = True,
     flip_test: bool = False,
     calibration=None,
+    floor: float | None = None,
 ):
     """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
 
@@ -182,6 +183,9 @@ def load_motion(
         A calibration file (DESIGN.md, "Cameras and calibration files") with
         the video's camera; without it the fit estimates the camera from the
         person.  Nothing beside the input is ever read in its place.
+    floor : float, optional
+        The floor's height, metres (see :func:`capture`); the joints are
+        moved so that it is z = 0.
 
     Returns
     -------
@@ -209,6 +213,8 @@ def load_motion(
             log.info("capture: using the camera of %s", calibration)
         t0 = time.perf_counter()
         motion = fit_track(track, camera=camera)
+        if floor is not None:
+            motion = _lowered(motion, floor)
         seconds["fitting"] = time.perf_counter() - t0
         return motion, track, seconds
     if calibration is not None:
@@ -216,11 +222,39 @@ def load_motion(
     from capture2notation.fitting.motion import read_motion
 
     t0 = time.perf_counter()
-    motion = read_motion(path)
+    motion = read_motion(path, floor=floor)
     seconds["read"] = time.perf_counter() - t0
     if fps_override is not None:
         motion = _with_fps(motion, fps_override)
     return motion, None, seconds
+
+
+def _lowered(motion, floor: float):
+    """`motion` moved down by `floor` metres, so a floor at that height is z = 0."""
+    shift = np.array([0.0, 0.0, float(floor)])
+    return replace(motion, joints=np.asarray(motion.joints) - shift, root=np.asarray(motion.root) - shift)
+
+
+#: Confidence of a foot's ankle and toe from which the capture counts it as
+#: seen: a Kinect's inferred joints carry 0.3, a BlazePose landmark off the
+#: image or hidden well under 0.5; only a seen foot may show the floor.
+FOOT_SEEN_CONFIDENCE = 0.5
+
+
+def feet_seen(motion) -> np.ndarray | None:
+    """(T, 2) right, left foot seen (ankle and toe at :data:`FOOT_SEEN_CONFIDENCE`), or None without confidence."""
+    conf = getattr(motion, "confidence", None)
+    if conf is None:
+        return None
+    conf = np.asarray(conf, float)
+    return np.stack(
+        [
+            np.minimum(conf[:, joint_index(f"{side}_ankle")], conf[:, joint_index(f"{side}_toe")])
+            >= FOOT_SEEN_CONFIDENCE
+            for side in ("right", "left")
+        ],
+        axis=1,
+    )
 
 
 #: ``tempo=`` (``--tempo``) value that writes time as it is: one beat a second.
@@ -257,6 +291,7 @@ def capture(
     flip_test: bool = False,
     axes: str = "standard",
     calibration=None,
+    floor: float | None = None,
 ) -> CaptureResult:
     """Capture notation from a video or motion file.
 
@@ -293,6 +328,11 @@ def capture(
         The score's key (DESIGN.md, "Cross of axes").
     calibration : str or Path, optional
         Calibration file with the video's camera (see :func:`load_motion`).
+    floor : float, optional
+        The floor's height, metres, where the user knows it better than the
+        capture: in a motion file's own coordinates once read (z up), or in
+        a video's world (the calibration's, whose floor is z = 0, or the
+        fit's own).  Found from the feet by default.
 
     Returns
     -------
@@ -302,7 +342,7 @@ def capture(
     kind = input_kind(input_path)
     outdir = Path(outdir)
     motion, track, seconds = load_motion(
-        input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration
+        input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration, floor=floor
     )
     estimate, camera_source = None, ""
     if track is not None:
@@ -331,11 +371,20 @@ def capture(
         evidence, sound = _sound_evidence(input_path, fps)
         seconds["sound"] = time.perf_counter() - t0
     t0 = time.perf_counter()
+    seen = feet_seen(motion)
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
     given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
     try:
         seg = segment_motion(
-            joints, fps, tempo=given, meter=meter, params=params, title=title, tempo_evidence=evidence, axes=axes
+            joints,
+            fps,
+            tempo=given,
+            meter=meter,
+            params=params,
+            title=title,
+            tempo_evidence=evidence,
+            axes=axes,
+            feet_seen=seen,
         )
     except QuantiseError as exc:
         if tempo is not None:
@@ -343,7 +392,14 @@ def capture(
         # Too few movements for a beat: time as it is, one beat a second, and say so.
         log.warning("capture: no beat found (%s): writing %d bpm, one beat a second", exc, SECONDS_TEMPO)
         seg = segment_motion(
-            joints, fps, tempo=Fraction(SECONDS_TEMPO), meter=meter, params=params, title=title, axes=axes
+            joints,
+            fps,
+            tempo=Fraction(SECONDS_TEMPO),
+            meter=meter,
+            params=params,
+            title=title,
+            axes=axes,
+            feet_seen=seen,
         )
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:

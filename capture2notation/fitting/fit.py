@@ -33,9 +33,10 @@ from dataclasses import replace
 import numpy as np
 
 from ..body import JOINTS, Body, joint_index
-from ..errors import FittingError
+from ..errors import FittingError, MotionFileError
 from .camera import DEFAULT_HFOV_DEG, Camera
 from .depth import DepthOptions, choose_arm_depths, remove_leg_rest_offsets
+from .ground import fit_floor, level_points
 from .model import PoseModel
 from .result import FitResult
 from .solver import (
@@ -337,7 +338,7 @@ def fit_keypoints(
         # A joint is only as sure as the direction of the segment it ends.
         joint_conf *= spread_factor(direction_spread(model, params, terms, fps, opt), opt.spread_deg)
     result = to_result(model, params, fps, times, joint_conf, usable)
-    return _floored(result, model) if set_floor else result
+    return _floored(result) if set_floor else result
 
 
 #: Model points that can touch the floor.
@@ -375,17 +376,21 @@ def _joint_confidence(names, tconf) -> np.ndarray:
     return out
 
 
-def _floored(res: FitResult, model: PoseModel) -> FitResult:
-    """Shift the clip so its lowest feet touch z = 0 (2nd percentile, robust to glitches)."""
-    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
-    low = np.nanmin(res.joints[:, feet, 2], axis=1) if np.any(np.isfinite(res.joints)) else np.array([np.nan])
-    if not np.any(np.isfinite(low)):
-        return res
-    rest = model.forward(np.zeros((1, model.n_params)))[0, :_J]
-    rest_low = rest[feet, 2].min() - rest[:, 2].min() + model.body.rest[:, 2].min()
-    dz = rest_low - np.nanpercentile(low, 2)
-    shift = np.array([0.0, 0.0, dz])
-    return res.replace(joints=res.joints + shift, root=res.root + shift)
+def _floored(res: FitResult) -> FitResult:
+    """The clip levelled so the floor its feet stand on is z = 0 (:func:`~.ground.fit_floor`).
+
+    Without a known camera the fit's floor is its own guess.  DESIGN.md's
+    floor is where the feet rest longest, so its height is fitted to the
+    lowest foot points of the whole clip (a low quantile, not the lowest
+    glitch), as for a motion file; it stays level (the fitted feet's depth
+    errors would read as a tilt: limb errors doubled on random scores).
+    """
+    ok = (np.asarray(res.confidence) > 0) & np.all(np.isfinite(res.joints), axis=-1)
+    try:
+        floor = fit_floor(res.joints, ok, None, tilt=False)
+    except MotionFileError:
+        return res  # no foot ever seen: the floor stays the fit's own
+    return res.replace(joints=level_points(res.joints, floor), root=level_points(res.root[:, None], floor)[:, 0])
 
 
 def refine_focal(

@@ -157,7 +157,7 @@ def _running_quantile(x: np.ndarray, width: int, q: float) -> np.ndarray:
     return out
 
 
-def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float) -> FloorFit:
+def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float | None, tilt: bool = True) -> FloorFit:
     """Fit the floor under a motion from its lowest foot points.
 
     Parameters
@@ -166,8 +166,13 @@ def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float) -> FloorFit:
         Our joints, z up, metres (NaN where missing).
     ok : (T, J) ndarray of bool
         Joints tracked.
-    fps : float
-        Frames per second (for the drift window).
+    fps : float or None
+        Frames per second (for the drift window); None fits one constant
+        height (no time axis to drift along).
+    tilt : bool
+        Fit the floor's tilt (a pitched sensor); False keeps it level, for
+        joints whose vertical is already known (a fit through a camera,
+        where a tilt read off the fitted feet is their depth error).
 
     Returns
     -------
@@ -182,7 +187,7 @@ def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float) -> FloorFit:
     good = np.isfinite(low).all(axis=1)
     if not good.any():
         raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
-    width = max(3, int(round(DRIFT_WINDOW_S * fps)))
+    width = max(3, int(round(DRIFT_WINDOW_S * fps))) if fps is not None else len(low)
     # Tilt and drift are fitted in turn: a drift seen as a tilt (or the
     # reverse) leaves a residual the other then takes up.
     slope = np.zeros(2)
@@ -192,7 +197,7 @@ def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float) -> FloorFit:
     for _ in range(_ALTERNATIONS):
         resid = low[good].copy()
         resid[:, 2] -= base
-        slope = _fit_tilt(resid)
+        slope = _fit_tilt(resid) if tilt else np.zeros(2)
         z[good] = low[good, 2] - low[good, :2] @ slope
         run = _running_quantile(z, width, GROUND_QUANTILE) if good.sum() > width else None
         if run is None or float(np.nanmax(run) - np.nanmin(run)) <= DRIFT_MIN_M:

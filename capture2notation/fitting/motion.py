@@ -21,6 +21,7 @@ from ..errors import MotionFileError
 from ..io.bvh import parse_bvh, read_bvh_points, read_own_bvh
 from ..io.kinect import kinect_points, read_kinect_csv
 from .fit3d import fit_points3d
+from .ground import FloorFit, fit_floor, level_points
 from .model import PoseModel
 from .result import FitResult
 
@@ -87,7 +88,9 @@ def joints_for_labels(motion: MotionData) -> np.ndarray:
     return out
 
 
-def read_motion(path, joint_map: dict | None = None, body: Body | None = None) -> MotionData:
+def read_motion(
+    path, joint_map: dict | None = None, body: Body | None = None, floor: float | None = None
+) -> MotionData:
     """Read a motion file, dispatching on its extension.
 
     Parameters
@@ -99,6 +102,10 @@ def read_motion(path, joint_map: dict | None = None, body: Body | None = None) -
         BVH only: source joint name -> our joint name, overriding the name table.
     body : Body, optional
         Proportions for segments the source does not measure (default ``Body()``).
+    floor : float, optional
+        The floor's height, metres, in the file's coordinates once read (z
+        up, the reader's units): when the user knows it.  By default it is
+        fitted to the feet (:func:`normalise_world`).
 
     Returns
     -------
@@ -115,13 +122,13 @@ def read_motion(path, joint_map: dict | None = None, body: Body | None = None) -
             return _own_motion(skel.fps, *own)
         points, conf, head, fps = read_bvh_points(skel, joint_map, where=path)
         head_c = None if head is None else np.ones(len(head))
-        return _fit(points, conf, head, head_c, fps, None, body, "bvh")
+        return _fit(points, conf, head, head_c, fps, None, body, "bvh", floor=floor)
     if ext == ".csv":
         times, pos, kconf, fps = read_kinect_csv(path)
         points, conf, head, head_c = kinect_points(pos, kconf)
         if not np.any(conf > 0):
             raise MotionFileError(f"{path}: no tracked joints in any row")
-        return _fit(points, conf, head, head_c, fps, times, body, "kinect", keep_points=True)
+        return _fit(points, conf, head, head_c, fps, times, body, "kinect", keep_points=True, floor=floor)
     if ext == ".npz":
         return motion_from_truth(path)
     raise MotionFileError(f"{path}: unknown motion file type {ext!r}; expected .bvh, .csv (Kinect v2) or .npz (truth)")
@@ -143,9 +150,11 @@ def _own_motion(fps, angles, root, offsets) -> MotionData:
     )
 
 
-def _fit(points, conf, head, head_c, fps, times, body, source, keep_points: bool = False) -> MotionData:
+def _fit(
+    points, conf, head, head_c, fps, times, body, source, keep_points: bool = False, floor: float | None = None
+) -> MotionData:
     extra = [] if head is None else [head]
-    points, extra = normalise_world(points, conf, extra)
+    points, extra = normalise_world(points, conf, extra, fps=fps, floor=floor)
     virtual = {} if head is None else {"head_centre": (extra[0], head_c)}
     res = fit_points3d(points, conf, fps, body=body, times=times, virtual=virtual)
     measured = None
@@ -183,7 +192,7 @@ def motion_from_truth(path) -> MotionData:
     )
 
 
-def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
+def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=(), fps: float | None = None, floor=None):
     """Floor at z = 0, start at the origin, initially facing +y.
 
     Parameters
@@ -193,6 +202,13 @@ def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
     confidence : (T, J) ndarray
     extra : sequence of (T, 3) ndarray
         Other points to move with the body.
+    fps : float, optional
+        Frames per second: with it the floor may drift with time (inertial
+        mocap); without, one tilted plane.
+    floor : float, optional
+        The floor's height in the file's own (z-up, metre) coordinates, when
+        the user knows it (``c2n capture --floor``); found from the feet
+        otherwise.
 
     Returns
     -------
@@ -201,22 +217,21 @@ def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
 
     Notes
     -----
-    The floor is the 2nd percentile over frames of the lowest foot point,
-    less that point's rest height (so a toe rests at its model height);
-    the facing is the horizontal right-hip − left-hip direction (shoulders
-    if the hips are missing), median over the first second of valid frames.
+    The floor is fitted to the lowest foot point of every frame
+    (:func:`~capture2notation.fitting.ground.fit_floor`: a tilt for a
+    pitched sensor, a height that may drift) and levelled to z = 0; the
+    facing is the horizontal right-hip − left-hip direction (shoulders if
+    the hips are missing), median over the first second of valid frames.
     """
     points = np.asarray(points, float)
     conf = np.asarray(confidence, float)
     ok = (conf > 0) & np.all(np.isfinite(points), axis=-1)
-    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
-    rest = Body().rest
-    fz = np.where(ok[:, feet], points[:, feet, 2] - rest[feet, 2], np.nan)
-    if not np.any(np.isfinite(fz)):
-        raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
-    floor = np.nanpercentile(
-        np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2
-    )
+    if floor is None:
+        fit = fit_floor(points, ok, fps)
+    else:
+        fit = FloorFit(slope=np.zeros(2), height=np.full(len(points), float(floor)), drifts=False, ground_fraction=1.0)
+    points = level_points(points, fit)
+    extra = [level_points(np.asarray(e, float)[:, None], fit)[:, 0] for e in extra]
     right = None
     for a, b in (("right_hip", "left_hip"), ("right_shoulder", "left_shoulder")):
         ia, ib = joint_index(a), joint_index(b)
@@ -235,7 +250,7 @@ def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
     pel = joint_index("pelvis")
     start_frames = np.nonzero(ok[:, pel])[0]
     centre = points[start_frames[0], pel] if start_frames.size else np.nanmean(points[0], axis=0)
-    shift = np.array([centre[0], centre[1], floor])
+    shift = np.array([centre[0], centre[1], 0.0])
 
     def move(p):
         return (np.asarray(p, float) - shift) @ Rz.T

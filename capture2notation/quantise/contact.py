@@ -34,6 +34,7 @@ __all__ = [
     "AIR_HEIGHT_SCALE_M",
     "AIR_SPEED_SD_MS",
     "FLOOR_SPEED_SD_MS",
+    "MAX_HEIGHT_SD_M",
     "MEAN_FLIGHT_S",
     "MEAN_STANCE_S",
     "MIN_HEIGHT_SD_M",
@@ -57,6 +58,12 @@ AIR_SPEED_SD_MS = 1.0
 MEAN_STANCE_S = 0.8
 #: Seconds: mean duration of a foot's flight in a step (0.2-0.5 s).
 MEAN_FLIGHT_S = 0.3
+#: Metres: largest standard deviation of a grounded foot's height believed.
+#: A clip whose lowest foot heights scatter more than this about the floor
+#: does not stand on that floor (a floor guessed 10 cm low, a figure lying
+#: down): its feet are read in the air rather than the floor stretched to
+#: reach them.
+MAX_HEIGHT_SD_M = 0.04
 #: Quantile of the clip's foot heights whose spread about the floor
 #: estimates ``σ_h`` (the lower half: grounded frames dominate it).
 _SPREAD_QUANTILE = 0.25
@@ -103,8 +110,18 @@ def decode_contacts(joints: np.ndarray, fps: float, floor: float = 0.0, seen: np
     """
     joints = np.asarray(joints, float)
     T = joints.shape[0]
+    # After the clip the body holds its last pose (DESIGN.md: a part with no
+    # symbol holds its position), as the per-frame rule assumes by taking
+    # the last frame as still.  Without those held frames a foot landing on
+    # the clip's last frames never pays the cost of entering a stance.
+    hold = max(1, int(round(MEAN_FLIGHT_S * fps)))
+    joints = np.concatenate([joints, np.repeat(joints[-1:], hold, axis=0)]) if T else joints
+    if seen is not None:
+        seen = np.asarray(seen, bool)
+        seen = np.concatenate([seen, np.repeat(seen[-1:], hold, axis=0)]) if T else seen
+    n = joints.shape[0]
     lows, mids = foot_points(joints)
-    out = np.zeros((T, 2), bool)
+    out = np.zeros((n, 2), bool)
     stay_floor = 1.0 - 1.0 / max(2.0, MEAN_STANCE_S * fps)
     stay_air = 1.0 - 1.0 / max(2.0, MEAN_FLIGHT_S * fps)
     logA = np.log(np.array([[stay_air, 1 - stay_air], [1 - stay_floor, stay_floor]]))
@@ -112,18 +129,18 @@ def decode_contacts(joints: np.ndarray, fps: float, floor: float = 0.0, seen: np
     for k in range(2):
         h = np.asarray(lows[k], float) - floor
         mid = np.asarray(mids[k], float)
-        v = np.zeros(T)
-        if T > 1:
+        v = np.zeros(n)
+        if n > 1:
             step = np.linalg.norm(np.diff(mid, axis=0), axis=-1) * fps
             v[1:-1] = 0.5 * (step[:-1] + step[1:])
             v[0], v[-1] = step[0], step[-1]
         ok = np.isfinite(h) & np.isfinite(v)
         if seen is not None:
-            ok &= np.asarray(seen, bool)[:, k]
+            ok &= seen[:, k]
         if not ok.any():
             continue
         low_h = h[ok][h[ok] <= np.quantile(h[ok], _SPREAD_QUANTILE)]
-        sd_h = max(MIN_HEIGHT_SD_M, float(np.sqrt(np.mean(low_h**2))) if low_h.size else 0.0)
+        sd_h = float(np.clip(np.sqrt(np.mean(low_h**2)) if low_h.size else 0.0, MIN_HEIGHT_SD_M, MAX_HEIGHT_SD_M))
         hh = np.where(ok, h, 0.0)
         vv = np.where(ok, v, 0.0)
         ll_floor = -0.5 * (hh / sd_h) ** 2 - np.log(sd_h * np.sqrt(2 * np.pi)) + _log_half_normal(vv, FLOOR_SPEED_SD_MS)
@@ -137,4 +154,4 @@ def decode_contacts(joints: np.ndarray, fps: float, floor: float = 0.0, seen: np
         ll_air = np.where(ok, ll_air, 0.0)
         path = _viterbi(np.column_stack([ll_air, ll_floor]), logA, log0)
         out[:, k] = path == 1
-    return out
+    return out[:T]

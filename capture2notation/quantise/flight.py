@@ -52,7 +52,9 @@ BALLISTIC_FRACTION = 0.5
 _SUPPORT_PARTS = ("support", "right_support", "left_support")
 
 
-def find_flights(joints: np.ndarray, fps: float, measured: bool, floor: float = 0.0) -> list[tuple[int, int]]:
+def find_flights(
+    joints: np.ndarray, fps: float, measured: bool, floor: float = 0.0, seen=None
+) -> list[tuple[int, int]]:
     """``(take_off, touchdown)`` frames of every flight.
 
     Parameters
@@ -64,6 +66,9 @@ def find_flights(joints: np.ndarray, fps: float, measured: bool, floor: float = 
         Fitted or recorded motion: flights must last :data:`MIN_MEASURED_FLIGHT_S`.
     floor : float
         Floor height, metres.
+    seen : (T, 2) array_like of bool, optional
+        Right, left foot measured at each frame; a foot not seen counts as
+        unknown, like a missing one.
 
     Returns
     -------
@@ -73,6 +78,8 @@ def find_flights(joints: np.ndarray, fps: float, measured: bool, floor: float = 
     low, _ = foot_points(np.asarray(joints, float))
     # Both feet clear of the floor (a missing foot counts as unknown: no flight).
     air = np.all(np.stack([lo - floor >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
+    if seen is not None:
+        air &= np.asarray(seen, bool).all(axis=1)
     edges = np.flatnonzero(np.diff(np.r_[0, air.astype(int), 0]))
     shortest = max(_MIN_CLEAN_FRAMES, int(np.ceil(MIN_MEASURED_FLIGHT_S * fps))) if measured else _MIN_CLEAN_FRAMES
     out = []

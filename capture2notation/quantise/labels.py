@@ -173,7 +173,7 @@ def foot_points(joints: np.ndarray) -> tuple[list, list]:
 
 
 def support_frames(
-    joints: np.ndarray, fps: float, floor: float = 0.0, flat_pitch=None
+    joints: np.ndarray, fps: float, floor: float = 0.0, flat_pitch=None, contact=None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Which feet support, and at which level, at every frame.
 
@@ -189,6 +189,11 @@ def support_frames(
         Pitch (degrees) of the right and left foot standing flat, e.g. from
         :func:`flat_foot_pitch`; the body model's rest pitch by default.
         The heel is raised when a foot pitches :data:`RELEVE_DEG` beyond it.
+    contact : (T, 2) array_like of bool, optional
+        Right, left foot on the floor, decided elsewhere (measured motion:
+        :func:`~capture2notation.quantise.contact.decode_contacts`); by
+        default DESIGN.md's per-frame rule (within :data:`SUPPORT_HEIGHT_M`
+        of the floor, slower than :data:`SUPPORT_SPEED_MS`).
 
     Returns
     -------
@@ -218,7 +223,11 @@ def support_frames(
             speed[-1] = 0.0
         else:
             speed[:] = 0.0
-        sup = (low < SUPPORT_HEIGHT_M) & (speed < SUPPORT_SPEED_MS)
+        sup = (
+            (low < SUPPORT_HEIGHT_M) & (speed < SUPPORT_SPEED_MS)
+            if contact is None
+            else np.asarray(contact, bool)[:, k]
+        )
         knee_bend = bend_angle(joints[:, joint_index(f"{side}_hip")], joints[:, joint_index(f"{side}_knee")], ankle)
         pitch = _foot_pitch_deg(joints, side)
         lev = np.full(T, MIDDLE)

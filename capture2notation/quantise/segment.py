@@ -76,12 +76,13 @@ from scipy.signal import savgol_filter
 from ..body import joint_index
 from ..errors import QuantiseError
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
+from .contact import decode_contacts
 from .flight import find_flights, with_flights
 from .labels import DIRECTION_NAMES, FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
 from .measured import held_pose, hold_frames, keep_previous, upright_trunk
 from .movement import Movement
 from .spans import _ZERO_SPEED, movement_spans
-from .supports import NOISY_POSITION_M, body_height, position_noise, smooth_positions, support_movements
+from .supports import MIN_GROUNDED, NOISY_POSITION_M, body_height, position_noise, smooth_positions, support_movements
 from .tempo import estimate_tempo_detail, snap
 from .timing import progress_signal, refine_times
 from .travel import unturn
@@ -283,6 +284,28 @@ def _channel(labels: FrameLabels, joints: np.ndarray, part: str) -> tuple[list, 
     return vec, [np.degrees(reach)], [labels.bend_deg[:, labels.index(part)]]
 
 
+def _floor_seen(feet_seen) -> bool:
+    """Whether the capture saw a foot often enough to find the floor; warns when not.
+
+    A foot the capture never saw (a Kinect's inferred feet, feet out of the
+    frame) cannot show where the floor is, so no support is written for it:
+    leg gestures only.  The bar is :data:`~.supports.MIN_GROUNDED`, the least
+    fraction of frames a dance stands on the floor.
+    """
+    if feet_seen is None:
+        return True
+    seen = np.asarray(feet_seen, bool)
+    fraction = float(np.mean(seen.any(axis=1))) if seen.size else 0.0
+    if fraction >= MIN_GROUNDED:
+        return True
+    warnings.warn(
+        f"the floor is never seen (a foot tracked in only {100 * fraction:.0f} % of {len(seen)} frames): "
+        "leg gestures only, no support symbols",
+        stacklevel=3,
+    )
+    return False
+
+
 def segment_motion(
     joints: np.ndarray,
     fps: float,
@@ -293,6 +316,7 @@ def segment_motion(
     title: str = "",
     tempo_evidence=None,
     axes: str = "standard",
+    feet_seen=None,
 ) -> Segmentation:
     """Segment a motion into notation symbols.
 
@@ -316,6 +340,9 @@ def segment_motion(
     axes : str
         The score's key: ``"standard"`` or ``"body"`` (arms and head read in
         the body cross of axes, :func:`~.labels.label_frames`).
+    feet_seen : (T, 2) array_like of bool, optional
+        Right, left foot measured by the capture at each frame (default:
+        wherever finite).  A foot not seen is never taken to bear weight.
 
     Returns
     -------
@@ -341,13 +368,16 @@ def segment_motion(
         # be "slower than 0.2 m/s" (DESIGN.md).  Contacts come from smoothed
         # joints, for the supports and for the legs alike.
         smoothed = smooth_positions(joints, fps)
-        contact, _ = support_frames(smoothed, fps, floor)
+        # Feet on the floor decoded over the whole clip: the per-frame rule
+        # loses a standing foot to a few millimetres of jitter at 100 fps.
+        contact = decode_contacts(smoothed, fps, floor, feet_seen)
         # Measured feet carry a pitch bias of their own: relevé is a heel
         # raised from the capture's own flat foot, not from the model's.
         flat = flat_foot_pitch(smoothed, contact) if measured else None
-        labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat))
+        labels = with_supports(labels, *support_frames(smoothed, fps, floor, flat_pitch=flat, contact=contact))
     # Flight from the feet's heights (smoothed when measured), before the supports are written.
-    flights = find_flights(smoothed if noisy_feet else joints, fps, measured, floor)
+    flights = find_flights(smoothed if noisy_feet else joints, fps, measured, floor, seen=feet_seen)
+    floor_seen = _floor_seen(feet_seen)
     height = body_height(joints)
     estimated = tempo_was_none = tempo is None
     moves, detail = None, None
@@ -355,7 +385,7 @@ def segment_motion(
         moves = (
             _gesture_movements(labels, joints, fps, params, measured=measured)
             + with_flights(
-                support_movements(labels, joints, fps, params, movement_spans, measured=measured),
+                support_movements(labels, joints, fps, params, movement_spans, measured=measured) if floor_seen else [],
                 labels,
                 joints,
                 fps,
@@ -418,7 +448,9 @@ def segment_motion(
             + with_flights(
                 support_movements(
                     labels, joints, fps, params, movement_spans, on_grid, measured=measured, turn_ends=ends
-                ),
+                )
+                if floor_seen
+                else [],
                 labels,
                 joints,
                 fps,

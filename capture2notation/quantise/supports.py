@@ -48,7 +48,7 @@ from scipy.signal import savgol_filter
 from ..body import joint_index
 from ..notation.directions import bend_angle, classify_indices
 from ..notation.model import LEVELS
-from .labels import DIRECTION_NAMES, FrameLabels, foot_points
+from .labels import DIRECTION_NAMES, SUPPORT_SPEED_MS, FrameLabels, foot_points
 from .movement import Movement
 
 __all__ = [
@@ -288,8 +288,13 @@ def support_movements(
 
 
 #: Noisy motion with feet on the floor in fewer frames than this fraction
-#: writes no support symbols (see :func:`_noisy_support_movements`).
-MIN_GROUNDED = 0.5
+#: writes no support symbols (see :func:`_noisy_support_movements`).  Even a
+#: run of leaps lands for 0.1-0.3 s between flights of 0.3-0.5 s (a fifth
+#: to a half of its frames; ``jesse_dance.bvh``: 10 %); feet found on the
+#: floor less often than this mean the floor itself is wrong (the contact
+#: decoder reads feet that never come within a few centimetres of it as in
+#: the air, :data:`~.contact.MAX_HEIGHT_SD_M`).
+MIN_GROUNDED = 0.05
 #: Least pelvis displacement of a noisy support change, metres: a plié to
 #: the DESIGN.md threshold (knees 30°) lowers it 2.8 cm, a relevé raises it
 #: 5 cm, a weight transfer moves it 8-10 cm; contact flicker moves it not at all.
@@ -347,11 +352,12 @@ def _noisy_support_movements(labels: FrameLabels, joints: np.ndarray, fps: float
     level = _pelvis_plie(part, level, smooth)
     grounded = float(np.mean(part >= 0))
     if grounded < MIN_GROUNDED:
-        # Our vocabulary has no jumps: feet found on the floor this rarely
-        # mean the floor height is wrong, and the supports would be invented.
+        # Feet found on the floor this rarely mean the floor height is wrong,
+        # and the supports would be invented.
         warnings.warn(
-            f"feet on the floor in only {100 * grounded:.0f} % of {T} frames (expected most of them; "
-            "is the floor height right?): no support symbols written",
+            f"feet on the floor in only {100 * grounded:.0f} % of {T} frames (even leaps land for "
+            f"{100 * MIN_GROUNDED:.0f} % or more; is the floor height right? --floor sets it): "
+            "no support symbols written",
             stacklevel=3,
         )
         return []
@@ -493,7 +499,6 @@ def _lifted(contact: np.ndarray, joints: np.ndarray, fps: float) -> np.ndarray:
     relevé rises and floats a few centimetres out of the contact band
     without either.
     """
-    from .labels import SUPPORT_SPEED_MS
 
     low, mid = foot_points(joints)
     out = ~np.asarray(contact, bool)
@@ -643,8 +648,8 @@ def _pelvis_over_foot(joints: np.ndarray, move) -> bool:
     return u > 1.0 - OVER_FOOT_FRACTION
 
 
-#: A fitted foot counted off the floor while the pelvis stays between the
-#: feet supports after all when its lowest point is within this of the
+#: A fitted foot counted off the floor while the pelvis is not over the
+#: other foot supports after all when its lowest point is within this of the
 #: other (supporting) foot's, metres.
 BALANCE_FOOT_M = 0.08
 #: Pelvis lowered below its standing height by this fraction of the body
@@ -663,8 +668,9 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
     weight can rest on one foot only with the pelvis over it
     (:func:`weight_bearing` asks for it within a quarter of the way to the
     other foot): a foot out of contact, slow, near the supporting foot's
-    height (:data:`BALANCE_FOOT_M`) while the pelvis stays between the
-    feet supports too.
+    height (:data:`BALANCE_FOOT_M`) while the pelvis is not over the
+    supporting foot supports too (between the feet, or over the foot that
+    left the floor: a fitted foot floating in a plié).
 
     Parameters
     ----------
@@ -686,13 +692,17 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
     pelvis = joints[:, joint_index("pelvis"), :2]
     low, mid = foot_points(joints)
     u = _fraction_along(pelvis, mid[0][:, :2], mid[1][:, :2])
-    between = (u > OVER_FOOT_FRACTION) & (u < 1.0 - OVER_FOOT_FRACTION)
+    # u = 0 over the right foot, 1 over the left: the weight can rest on the
+    # left foot alone only with u > 1 - OVER_FOOT_FRACTION, on the right
+    # alone only with u < OVER_FOOT_FRACTION.
+    over_other = (u < OVER_FOOT_FRACTION, u > 1.0 - OVER_FOOT_FRACTION)
     out = sup.copy()
     for k in range(2):
         step = np.linalg.norm(np.diff(mid[k], axis=0), axis=-1) * fps
         speed = np.r_[step[:1], np.fmin(step[1:], step[:-1]), step[-1:]] if step.size > 1 else np.zeros(len(sup))
         near = np.abs(low[k] - low[1 - k]) < BALANCE_FOOT_M
-        out[:, k] |= sup[:, 1 - k] & ~sup[:, k] & between & near & (speed < 0.2)
+        not_balanced = ~over_other[1 - k]
+        out[:, k] |= sup[:, 1 - k] & ~sup[:, k] & not_balanced & near & (speed < SUPPORT_SPEED_MS)
     if np.array_equal(out, sup):
         return labels
     # A restored foot stands at the level of the foot it shares the weight with.

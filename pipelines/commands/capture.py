@@ -7,9 +7,13 @@ from pathlib import Path
 
 import click
 
-from .options import FPS, TEMPO_OR_NONE, check_outdir
+from .options import FPS, TEMPO_OR_NONE, Number, check_outdir
 
 __all__ = ["capture"]
+
+#: A floor height a recording can have, metres: a motion file's origin may
+#: sit anywhere within a room-sized volume, never kilometres away.
+FLOOR = Number(-100.0, 100.0, "metres")
 
 
 @click.command("capture")
@@ -63,7 +67,18 @@ __all__ = ["capture"]
     help="A calibration file (TOML, as written by c2n render's camera.toml) with the video's camera; "
     "by default the camera is estimated from the person.",
 )
-def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes, calibration):
+@click.option(
+    "--floor",
+    type=FLOOR,
+    default=None,
+    metavar="HEIGHT_M",
+    help="The floor's height in metres, where you know it better than the capture: in a motion file's "
+    "coordinates (z up, once read) or in a video's world (a calibration's floor is 0). "
+    "By default it is found from the feet.",
+)
+def capture(
+    input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes, calibration, floor
+):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
     into notation files in OUTDIR."""
     from fractions import Fraction
@@ -94,6 +109,7 @@ def capture(input_path, outdir, backend, tempo, fps_override, grid, no_effort, s
         flip_test=flip_test,
         axes=axes,
         calibration=calibration,
+        floor=floor,
     )
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "

@@ -53,3 +53,28 @@ def test_a_foot_brushing_the_floor_fast_is_not_on_it():
         p[a:b, joint_index(f"right_{part}"), 2] += 0.01
     c = decode_contacts(p, FPS)
     assert not c[105:125, 0].any() and c[:, 1].all()
+
+
+def test_a_foot_landing_on_the_last_frames_is_on_the_floor():
+    """The clip ends as a foot lands: after the clip the body holds its pose
+    (DESIGN.md), so the landing is decoded like any other, as the per-frame
+    rule reads it; a foot still in the air at the end stays in the air."""
+    rng = np.random.default_rng(4)
+    p = _standing(300, rng, 0.001)
+    _lift(p, "right", 160, 240, 0.12)  # lifted for 0.8 s, down again on frame 239
+    c = decode_contacts(p[:240], FPS)  # the clip ends on the frame the foot lands
+    assert c[-1, 0] and c[:150].all() and not c[180:220, 0].any()
+    mid_air = decode_contacts(p[:195], FPS)  # ends near the top of the lift, 12 cm up
+    assert not mid_air[-1, 0] and mid_air[:, 1].all()
+
+
+def test_feet_far_above_the_floor_are_in_the_air():
+    """Feet that never come within a few centimetres of the floor (a floor
+    guessed 10 cm low) are not stretched onto it: the height spread a stance
+    may have is capped (:data:`~capture2notation.quantise.contact.MAX_HEIGHT_SD_M`)."""
+    rng = np.random.default_rng(5)
+    p = _standing(300, rng, 0.002)
+    p[..., 2] += 0.10
+    assert not decode_contacts(p, FPS).any()
+    p[..., 2] -= 0.10
+    assert decode_contacts(p, FPS).all()

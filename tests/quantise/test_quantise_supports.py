@@ -326,3 +326,28 @@ def test_barre_exercise_round_trips_exactly(name, fps):
         warnings.simplefilter("error", UnreachableWarning)
         joints = interpret(score, fps=fps).joints()
     assert score_differences(score, segment_motion(joints, fps, tempo=score.tempo).score) == []
+
+
+@pytest.mark.parametrize("pelvis_x", [0.0, 0.08])
+def test_a_floating_foot_under_the_pelvis_still_bears_weight(pelvis_x):
+    """Only the left foot is read on the floor (the fitted right foot floats
+    3 cm up, as fitted feet do in a plié), but the pelvis is between the feet
+    or over the right foot, never over the left: the weight cannot rest on
+    the left foot alone, so the right foot supports too.  Over the left foot
+    the one-foot support stands."""
+    from capture2notation.quantise.supports import _balanced_contacts
+
+    T = 20
+    joints = np.repeat(Body().rest[None], T, axis=0).copy()
+    joints[:, [joint_index("right_ankle"), joint_index("right_toe")], 2] += 0.03
+    joints[:, joint_index("pelvis"), 0] = pelvis_x  # the right foot is at x > 0 (DESIGN.md)
+    labels = label_frames(joints, 25.0)
+    sup = np.tile([False, True], (T, 1))
+    level = np.where(sup, 1, -1)
+    out = _balanced_contacts(with_supports(labels, sup, level), joints, 25.0)
+    assert np.asarray(out.supporting).all()
+    right_x = joints[0, joint_index("right_ankle"), 0]
+    left_x = joints[0, joint_index("left_ankle"), 0]
+    joints[:, joint_index("pelvis"), 0] = left_x - 0.1 * (left_x - right_x)  # over the left foot
+    over_left = _balanced_contacts(with_supports(labels, sup, level), joints, 25.0)
+    assert not np.asarray(over_left.supporting)[:, 0].any()
