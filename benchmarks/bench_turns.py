@@ -123,7 +123,7 @@ def bvh() -> None:
     from capture2notation.fitting.motion import joints_for_labels, read_motion
     from capture2notation.quantise.flight import find_flights
     from capture2notation.quantise.segment import segment_motion
-    from capture2notation.quantise.supports import smooth_positions
+    from capture2notation.quantise.support_state import smooth_positions
     from capture2notation.quantise.turns import continuous_front
 
     for path in sorted((FIXTURES / "bvh").glob("*.bvh")):

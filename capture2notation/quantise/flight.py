@@ -30,7 +30,7 @@ from ..notation.directions import classify_indices
 from ..notation.model import AIR, LEVELS
 from .labels import DIRECTION_NAMES, SUPPORT_HEIGHT_M, FrameLabels, foot_points
 from .movement import Movement
-from .supports import STEP_MIN_FRACTION, _step_direction, support_state
+from .support_state import STEP_MIN_FRACTION, step_direction, support_state
 
 __all__ = ["find_flights", "with_flights"]
 
@@ -205,7 +205,7 @@ def with_flights(
                 # Arrives at the take-off: the state held there.
                 p, lv = int(part[t0]), int(level[t0])
                 if p >= 0:
-                    step = _step_direction(joints, labels, m.start_frame, t0, p, height)
+                    step = step_direction(joints, labels, m.start_frame, t0, p, height)
                     kept.append(
                         Movement(_SUPPORT_PARTS[p], m.start_frame, t0, m.start_time, t0 / fps, step, LEVELS[lv])
                     )

@@ -43,7 +43,7 @@ def movement_spans(
         See :class:`~.segment.SegmentParams`.
     key_pose : callable, optional
         ``key_pose(frame, since) -> bool`` with attribute ``on_grid`` (see
-        :func:`~.segment._key_pose_fn`).  When given (clean motion), a run is split at
+        :func:`~.gestures._key_pose_fn`).  When given (clean motion), a run is split at
         the local speed minima it accepts, however shallow, and never
         elsewhere — a limb passing near its turning axis slows down
         mid-movement without arriving anywhere.

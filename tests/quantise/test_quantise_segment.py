@@ -172,8 +172,8 @@ def test_smooth_measured_motion_is_not_taken_for_the_dancer_truth():
     """A fit can be smoother than the clean-motion jitter limit (0.05°/frame)
     yet never exactly still: it must take the measured path (fitted timing,
     contacts from smoothed feet), not wait for exactly written poses."""
+    from capture2notation.quantise.gestures import has_exact_holds as _has_exact_holds
     from capture2notation.quantise.labels import label_frames
-    from capture2notation.quantise.segment import _has_exact_holds
 
     joints, _ = build_motion(MOVES, TEMPO)
     assert _has_exact_holds(label_frames(joints, 25.0), joints)

@@ -13,7 +13,7 @@ from capture2notation.compare.agreement import normalise
 from capture2notation.notation.effort import progress
 from capture2notation.quantise.labels import label_frames, with_supports
 from capture2notation.quantise.segment import segment_motion
-from capture2notation.quantise.supports import smooth_positions
+from capture2notation.quantise.support_state import smooth_positions
 
 FPS = 25.0
 
@@ -335,7 +335,7 @@ def test_a_floating_foot_under_the_pelvis_still_bears_weight(pelvis_x):
     or over the right foot, never over the left: the weight cannot rest on
     the left foot alone, so the right foot supports too.  Over the left foot
     the one-foot support stands."""
-    from capture2notation.quantise.supports import _balanced_contacts
+    from capture2notation.quantise.supports_measured import _balanced_contacts
 
     T = 20
     joints = np.repeat(Body().rest[None], T, axis=0).copy()
