@@ -5,8 +5,8 @@ length its depth is known up to a sign: the elbow lies on its pixel's ray at
 one of the two points a whole upper arm away from the shoulder, and the wrist
 likewise from the elbow.  Each arm therefore has four candidate poses per frame
 (elbow near / far × wrist near / far).  The continuous solver only refines
-whichever side it starts on, and the keypoint model's world landmarks, which
-used to decide the side alone, get it wrong often on foreshortened arms.
+whichever side it starts on, and the keypoint model's world landmarks alone
+get it wrong often on foreshortened arms.
 
 :func:`choose_arm_depths` scores the candidates of every frame with evidence
 a real video has and picks the sequence of minimum total cost by dynamic
@@ -35,19 +35,6 @@ magnitude stays the landmarks' only within the band the segment's image
 length allows (:mod:`~capture2notation.fitting.foreshorten`): near the
 image plane that band is wide (foreshortening against a model length is a
 poor measure there), far from it the image length decides.
-
-Measured through BlazePose on the built-in phrases and random scores 0–3
-(mannequin, 25 fps, 640×480): per-frame gesture label agreement front 75.8 →
-75.7 %, 45° 78.8 → 78.8 %, side 66.6 → 67.7 % (arms 41 → 44 %).  The world
-landmarks' arm depth hardly follows the truth on these renders (regression
-slope 0.1–0.4), and the errors that remain are mostly depth *magnitude*
-(place versus low, neighbouring sectors), which a sign choice cannot fix.
-Removing the landmarks' rest offset of arms and legs (2026-12-01,
-``bench_fitting.py --labels``, built-ins and random scores 0–5): median limb
-error front 13.0 → 10.6°, 45° 10.8 → 10.1°, side 10.8 → 10.3°; gesture
-labels front 74.9 → 75.8 %, 45° 73.4 → 74.8 %, side 66.5 → 66.9 %; score
-agreement on the same clips (tempo given) front 60.9 → 60.4 %, 45° 55.8 →
-59.3 %, side 40.4 → 46.9 %; MPJPE front 18.4 → 19.5 cm.
 """
 
 from __future__ import annotations

@@ -2,9 +2,9 @@
 
 With a calibrated camera the floor is the plane z = 0, so a foot point on the
 floor is where its pixel's ray meets that plane: its distance follows from
-one pixel, independently of any segment length.  The fit used to start from
-the figure's image size against the model's lengths, which puts the
-performer 0.2–0.4 m off through BlazePose (its landmarks sit inside the
+one pixel, independently of any segment length.  The figure's image size
+against the model's lengths puts the performer 0.2–0.4 m off through
+BlazePose (its landmarks sit inside the
 silhouette, so the figure looks small and far), and every arm's
 foreshortening is judged at that depth: 8 % too near makes an arm in the
 image plane look 8 % too long for the model, and one that leaves the plane
