@@ -87,8 +87,8 @@ def dancer_misses(score, motion, tol_deg: float = 0.05) -> int:
     lab = label_frames(motion.joints(), motion.fps)
     misses = 0
     for sym, _, f1 in motion.events:
-        if sym.is_support:
-            continue
+        if sym.is_support or sym.part not in lab.parts:
+            continue  # supports, turns and flight have no limb direction to reach
         f = min(f1, lab.vectors.shape[0] - 1)
         v = lab.vectors[f, lab.index(sym.part)]
         c = canonical_vector(sym.direction, sym.level)
