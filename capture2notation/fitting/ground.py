@@ -17,6 +17,13 @@ it), and kept only when the feet spread far enough on the floor to show it.
 The height is a running low quantile (:data:`GROUND_QUANTILE`) of the
 levelled lowest points over :data:`DRIFT_WINDOW_S` (longer than any flight
 of a jump), kept constant unless it drifts by more than :data:`DRIFT_MIN_M`.
+
+Without a time axis (``fps=None``: a video fit, whose feet scatter by
+centimetres about the floor they stand on) a low quantile sits a fraction
+of that scatter *below* the floor, and every standing foot floats above
+it.  There the height is the mean of a two-part mixture fitted by EM
+(:func:`ground_height`): grounded points normal about the floor, feet in
+the air exponentially above it.
 """
 
 from __future__ import annotations
@@ -38,6 +45,7 @@ __all__ = [
     "MIN_TILT_DEG",
     "FloorFit",
     "fit_floor",
+    "ground_height",
     "level_points",
 ]
 
@@ -70,6 +78,14 @@ MAX_TILT_DEG = 20.0
 #: mimics 1-1.5° (a 25 cm drift under a 1.5 m walk), and so does the
 #: body model's foot against a real one; below it the floor is level.
 MIN_TILT_DEG = 2.0
+#: Metres: least scatter of grounded foot points believed by
+#: :func:`ground_height` (the body model's sole against a real one).
+MIN_GROUND_SD_M = 0.005
+#: Metres: the first guess of the mixture's height scale of feet in the air
+#: (a step lifts a foot 5-15 cm); EM then fits it.
+AIR_SCALE_M = 0.1
+#: EM iterations of :func:`ground_height` (settles in 10-20 on video fits).
+_EM_STEPS = 50
 #: IRLS iterations of the tilt fit (converges in 3-5 on every fixture).
 _IRLS_STEPS = 10
 #: Rounds of tilt, then drift (two settle a drift of 25 cm under a 1.5 m walk).
@@ -115,6 +131,37 @@ def _lowest_points(points: np.ndarray, ok: np.ndarray) -> np.ndarray:
     low[:, 2] = z[np.arange(T), k]
     low[~np.isfinite(low[:, 2])] = np.nan
     return low
+
+
+def ground_height(z: np.ndarray) -> float:
+    """The floor under lowest foot points ``z`` (metres, ``(N,)``, finite), by EM.
+
+    A mixture: a fraction ``w`` of the points rest on the floor, ``N(c,
+    σ)``; the others are feet in the air, ``c + Exp(λ)`` above it.  Started
+    from the :data:`GROUND_QUANTILE` quantile; ``c`` is the grounded points'
+    weighted mean, so a scatter of several centimetres about the floor
+    (fitted feet) does not pull it down as a low quantile is.
+    """
+    z = np.asarray(z, float)
+    c = float(np.quantile(z, GROUND_QUANTILE))
+    sd = max(MIN_GROUND_SD_M, float(np.std(z[z <= np.quantile(z, 0.5)])))
+    lam, w = AIR_SCALE_M, 0.8
+    for _ in range(_EM_STEPS):
+        pg = w * np.exp(-0.5 * ((z - c) / sd) ** 2) / (sd * np.sqrt(2 * np.pi))
+        above = z > c
+        pa = np.where(above, (1 - w) * np.exp(-np.where(above, z - c, 0.0) / lam) / lam, 0.0)
+        r = pg / np.maximum(pg + pa, 1e-300)
+        if r.sum() < 1.0:
+            break
+        c_new = float(np.sum(r * z) / r.sum())
+        sd = max(MIN_GROUND_SD_M, float(np.sqrt(np.sum(r * (z - c_new) ** 2) / r.sum())))
+        lam = max(MIN_GROUND_SD_M, float(np.sum((1 - r) * np.maximum(z - c_new, 0.0)) / max((1 - r).sum(), 1e-9)))
+        w = float(np.clip(r.mean(), 0.05, 0.99))
+        done = abs(c_new - c) < 1e-5
+        c = c_new
+        if done:
+            break
+    return c
 
 
 def _fit_tilt(low: np.ndarray) -> np.ndarray:
@@ -203,7 +250,7 @@ def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float | None, tilt: bool 
         if run is None or float(np.nanmax(run) - np.nanmin(run)) <= DRIFT_MIN_M:
             break
         base = run[good]
-    const = float(np.quantile(z[good], GROUND_QUANTILE))
+    const = float(np.quantile(z[good], GROUND_QUANTILE)) if fps is not None else ground_height(z[good])
     drifts = run is not None and float(np.nanmax(run) - np.nanmin(run)) > DRIFT_MIN_M
     height = run if drifts and run is not None else np.full(len(z), const)
     with np.errstate(invalid="ignore"):

@@ -140,7 +140,10 @@ def measured_support_movements(labels: FrameLabels, joints: np.ndarray, fps: flo
         return []
     w = max(3, int(round(0.3 * fps)) | 1)
     code = mode_filter(_state_code(part, level), w)
-    min_len = max(1, int(round(MIN_SUPPORT_S * fps)))
+    # Held means seen in two frames at least: at 5 fps one frame is already
+    # MIN_SUPPORT_S, and a state seen once is the fit's flicker (a squat's
+    # rising foot leaves the contact band for one frame on its way down).
+    min_len = max(2, int(round(MIN_SUPPORT_S * fps)))
 
     def held(c: int, a: int, b: int) -> bool:
         # Grounded runs held long enough.  The last may be short if it
@@ -435,6 +438,15 @@ BALANCE_FOOT_M = 0.08
 PLIE_DROP_FRACTION = 0.0165
 
 
+def _distance_to_foot(joints: np.ndarray, p: np.ndarray, side: str) -> np.ndarray:
+    """Horizontal distance, metres ``(T,)``, from points `p` ``(T, 2)`` to the `side` foot (ankle to toe)."""
+    a = joints[:, joint_index(f"{side}_ankle"), :2]
+    b = joints[:, joint_index(f"{side}_toe"), :2]
+    with np.errstate(invalid="ignore"):
+        u = np.clip(np.nan_to_num(fraction_along(p, a, b)), 0.0, 1.0)
+    return np.linalg.norm(p - (a + u[:, None] * (b - a)), axis=-1)
+
+
 def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> FrameLabels:
     """Contacts of measured feet, with a foot that flickers off the floor while it still carries weight put back.
 
@@ -446,8 +458,9 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
     (:func:`weight_bearing` asks for it within a quarter of the way to the
     other foot): a foot out of contact, slow, near the supporting foot's
     height (:data:`BALANCE_FOOT_M`) while the pelvis is not over the
-    supporting foot supports too (between the feet, or over the foot that
-    left the floor: a fitted foot floating in a plié).
+    supporting foot supports too (between the feet, over the foot that
+    left the floor, or behind both: a fitted foot floating in a plié or a
+    squat).
 
     Parameters
     ----------
@@ -468,11 +481,14 @@ def _balanced_contacts(labels: FrameLabels, joints: np.ndarray, fps: float) -> F
         return labels
     pelvis = joints[:, joint_index("pelvis"), :2]
     low, mid = foot_points(joints)
-    u = fraction_along(pelvis, mid[0][:, :2], mid[1][:, :2])
-    # u = 0 over the right foot, 1 over the left: the weight can rest on the
-    # left foot alone only with u > 1 - OVER_FOOT_FRACTION, on the right
-    # alone only with u < OVER_FOOT_FRACTION.
-    over_other = (u < OVER_FOOT_FRACTION, u > 1.0 - OVER_FOOT_FRACTION)
+    # The weight rests on one foot alone only with the pelvis over it: within
+    # OVER_FOOT_FRACTION of the feet's distance of that foot (heel to toe),
+    # in any direction (a squat sits the pelvis 30 cm behind both feet: over
+    # neither, whatever its projection on the line between them).
+    apart = np.linalg.norm(mid[1][:, :2] - mid[0][:, :2], axis=-1)
+    over_other = tuple(
+        _distance_to_foot(joints, pelvis, side) < OVER_FOOT_FRACTION * apart for side in ("right", "left")
+    )
     out = sup.copy()
     for k in range(2):
         step = np.linalg.norm(np.diff(mid[k], axis=0), axis=-1) * fps

@@ -13,7 +13,25 @@ __all__ = ["capture"]
 
 #: A floor height a recording can have, metres: a motion file's origin may
 #: sit anywhere within a room-sized volume, never kilometres away.
-FLOOR = Number(-100.0, 100.0, "metres")
+FLOOR_HEIGHT = Number(-100.0, 100.0, "metres")
+
+
+class FloorOrAuto(click.ParamType):
+    """``--floor``: ``auto`` (found from the feet; None) or a height in :data:`FLOOR_HEIGHT`'s range."""
+
+    name = "floor"
+
+    def convert(self, value, param, ctx):
+        if value is None or (isinstance(value, str) and value.strip().lower() == "auto"):
+            return None
+        try:
+            return FLOOR_HEIGHT.convert(value, param, ctx)
+        except click.BadParameter as exc:
+            self.fail(f"{exc.message}; or 'auto' to find it from the feet", param, ctx)
+
+
+#: ``--floor`` of a capture.
+FLOOR = FloorOrAuto()
 
 
 @click.command("capture")
@@ -70,11 +88,11 @@ FLOOR = Number(-100.0, 100.0, "metres")
 @click.option(
     "--floor",
     type=FLOOR,
-    default=None,
-    metavar="HEIGHT_M",
+    default="auto",
+    metavar="auto|HEIGHT_M",
     help="The floor's height in metres, where you know it better than the capture: in a motion file's "
     "coordinates (z up, once read) or in a video's world (a calibration's floor is 0). "
-    "By default it is found from the feet.",
+    "Default 'auto': found from the feet (a motion file's tilt and drift too).",
 )
 def capture(
     input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes, calibration, floor

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from capture2notation.notation.formats import read
 from pipelines.cli import main
 
 _MOCAP = "bvh/test_mocapbank.bvh"
@@ -206,3 +207,33 @@ def test_progress_is_a_bar_on_a_terminal(monkeypatch):
     bar = progress.progress(total=3, desc="x")
     assert isinstance(bar, tqdm)
     bar.close()
+
+
+@pytest.mark.filterwarnings("default:feet on the floor in only")  # the 30 cm low floor: shown, as for a user
+def test_floor_option_takes_auto_or_a_height_and_names_a_bad_value(fixture_path, tmp_path):
+    """``--floor auto`` is the default (the floor found from the feet: the
+    fixture dance writes supports); a height moves it (30 cm below the file's
+    lowest joint: the feet never reach it, no support); anything else is one
+    line naming the option and the value, exit 2."""
+    from capture2notation.io.bvh import parse_bvh, read_bvh_points
+
+    path = fixture_path("bvh/test_mocapbank.bvh")
+    points, _conf, _head, _fps = read_bvh_points(parse_bvh(path), None, where=path)
+    lowest = float(np.nanmin(points[..., 2]))
+    code, _out, err = _run("capture", path, "-o", tmp_path / "a", "--no-effort", "--tempo", 120, "--floor", "auto")
+    assert code == 0, err
+    auto = read(tmp_path / "a" / "score.lab")
+    assert [s for s in auto.symbols if s.is_support and s.level is not None]
+    code, _out, err = _run(
+        "capture", path, "-o", tmp_path / "b", "--no-effort", "--tempo", 120, "--floor", f"{lowest - 0.30:.4f}"
+    )
+    assert code == 0, err
+    low = read(tmp_path / "b" / "score.lab")
+    assert not [s for s in low.symbols if s.is_support and s.level is not None]
+    code, _out, err = _run("capture", path, "-o", tmp_path / "c", "--floor", "ground")
+    assert code == 2
+    line = [x for x in err.splitlines() if x.strip()]
+    assert len(line) == 1 and "--floor" in line[0] and "'ground'" in line[0] and "auto" in line[0], err
+    assert "Traceback" not in err
+    code, _out, err = _run("capture", "--help")
+    assert "--floor auto|HEIGHT_M" in " ".join(err.split() + _out.split())

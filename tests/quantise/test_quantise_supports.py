@@ -351,3 +351,25 @@ def test_a_floating_foot_under_the_pelvis_still_bears_weight(pelvis_x):
     joints[:, joint_index("pelvis"), 0] = left_x - 0.1 * (left_x - right_x)  # over the left foot
     over_left = _balanced_contacts(with_supports(labels, sup, level), joints, 25.0)
     assert not np.asarray(over_left.supporting)[:, 0].any()
+
+
+def test_a_squat_sitting_back_behind_both_feet_stands_on_both():
+    """A squat sits the pelvis 30 cm behind the feet (the trunk leans forward
+    to keep the balance over them).  With the right foot set 10 cm ahead of
+    the left, the pelvis projects onto the line between the feet beyond the
+    left foot, yet it is over neither foot: a fitted right foot floating out
+    of contact still bears weight (``pose_squats.mp4`` wrote
+    ``left_support low`` for each squat)."""
+    from capture2notation.quantise.supports_measured import _balanced_contacts
+
+    T = 20
+    joints = np.repeat(Body().rest[None], T, axis=0).copy()
+    joints[:, [joint_index("right_ankle"), joint_index("right_toe")], 1] += 0.10
+    joints[:, [joint_index("right_ankle"), joint_index("right_toe")], 2] += 0.03
+    joints[:, joint_index("pelvis"), :2] = [0.0, -0.30]
+    labels = label_frames(joints, 25.0)
+    sup = np.tile([False, True], (T, 1))
+    out = _balanced_contacts(with_supports(labels, sup, np.where(sup, 0, -1)), joints, 25.0)
+    assert np.asarray(out.supporting).all()
+    # Its level is the standing foot's (low here, a plié).
+    assert (np.asarray(out.support_level) == 0).all()
