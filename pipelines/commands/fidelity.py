@@ -68,7 +68,9 @@ def fidelity_study(config_path, quick, scheduler, workers, seed, capture, outdir
         f"in {time.perf_counter() - t0:.0f} s; capture path: {s['capture']}"
     )
     for mode, other in s.get("other_captures", {}).items():
-        click.echo(f"also captured on the {mode} path: {other['jobs']['total']} jobs ({other['jobs']['failed']} failed)")
+        click.echo(
+            f"also captured on the {mode} path: {other['jobs']['total']} jobs ({other['jobs']['failed']} failed)"
+        )
     if base:
         click.echo(f"observer at baseline: {base['percent_correct']:.1f} % correct (experts 78.70 %)")
     click.echo(f"report: {outdir}/report.html")

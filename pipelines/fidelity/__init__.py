@@ -24,6 +24,7 @@ __all__ = [
     "run_study",
 ]
 
+
 def run_fidelity_study(
     cfg: StudyConfig,
     outdir,

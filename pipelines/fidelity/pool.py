@@ -204,14 +204,14 @@ def _execute_dask(fn, items, on_done, scheduler, timeout, on_progress) -> None:
             if fut.key not in handled and fut.status == "finished":
                 try:
                     row = fut.result(timeout=DASK_FETCH_S)
-                except Exception as exc:  # noqa: BLE001 - the job is simply rerun next time
+                except Exception as exc:  # the job is simply rerun next time
                     log.warning("finished Dask job %s not kept: %s", fut.key, exc)
                     continue
                 on_done(index[fut.key], row)
         # The cluster is not ours to kill: cancel our jobs so its workers stop computing them.
         try:
             client.cancel(futures, force=True)
-        except Exception as exc:  # noqa: BLE001 - we are stopping anyway
+        except Exception as exc:  # we are stopping anyway
             log.warning("could not cancel the Dask jobs: %s", exc)
         raise
     finally:

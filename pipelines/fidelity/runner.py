@@ -18,8 +18,8 @@ import json
 import logging
 import math
 import os
-import time
 import signal
+import time
 from dataclasses import asdict
 from fractions import Fraction
 from pathlib import Path
@@ -43,7 +43,15 @@ from .config import AUTO_CAPTURE, StudyConfig
 from .measure import builtin_scores, capture, kept_frames, measure, perform
 from .pool import StudyInterrupted, _Stop, execute, signal_of, stop_on_signals
 
-__all__ = ["STUDY_VERSION", "StudyInterrupted", "StudyResult", "load_cached", "resolve_capture", "run_condition", "run_study"]
+__all__ = [
+    "STUDY_VERSION",
+    "StudyInterrupted",
+    "StudyResult",
+    "load_cached",
+    "resolve_capture",
+    "run_condition",
+    "run_study",
+]
 
 log = logging.getLogger(__name__)
 
@@ -169,7 +177,7 @@ def load_cached(path: Path, digest: str, job: Job, mode: str) -> dict | None:
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         log.warning("cache file %s is unreadable (%s); rerunning its job", path, exc)
         return None
-    if not isinstance(row, dict) or not ROW_KEYS <= set(row):
+    if not isinstance(row, dict) or not set(row) >= ROW_KEYS:
         what = f"keys {sorted(row)[:6]}" if isinstance(row, dict) else type(row).__name__
         log.warning("cache file %s is not a result row (%s); rerunning its job", path, what)
         return None

@@ -143,7 +143,8 @@ def _children(pid: int) -> list[int]:
     for d in os.listdir("/proc"):
         if d.isdigit():
             try:
-                stat = open(f"/proc/{d}/stat").read()
+                with open(f"/proc/{d}/stat") as f:
+                    stat = f.read()
             except OSError:
                 continue
             if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
@@ -153,7 +154,8 @@ def _children(pid: int) -> list[int]:
 
 def _running(pid: int) -> bool:
     try:
-        state = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0]
+        with open(f"/proc/{pid}/stat") as f:
+            state = f.read().rsplit(")", 1)[1].split()[0]
     except OSError:
         return False
     return state != "Z"  # a zombie computes nothing; it only waits to be reaped
@@ -198,3 +200,27 @@ def test_killing_the_parent_leaves_no_worker_behind(tmp_path, sig):
     proc.wait(timeout=HANG_S)
     assert not _wait_gone(workers), "orphaned workers still running"
     assert all(json.loads(f.read_text())["job"] == f.stem for f in cache.glob("*.json"))
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:feet on the floor")
+def test_two_capture_paths_are_run_and_compared_per_condition(tmp_path):
+    from pipelines.fidelity import run_fidelity_study
+    from pipelines.fidelity.report import capture_comparison
+
+    cfg = StudyConfig(**{**TINY, "capture": ("truth", "keypoints")})
+    res = run_fidelity_study(cfg, tmp_path, workers=1, progress=False)
+    assert list(res.by_capture) == ["truth", "keypoints"] and res.summary["capture"] == "truth"
+    assert res.summary["other_captures"]["keypoints"]["jobs"]["total"] == 12
+    rows = (tmp_path / "results.csv").read_text().splitlines()
+    col = rows[0].split(",").index("capture")
+    assert sorted({r.split(",")[col] for r in rows[1:]}) == ["keypoints", "truth"] and len(rows) == 1 + 24
+    lines, cols = capture_comparison(res.by_capture)
+    assert len(lines) == 2 and "symbol_accuracy [truth]" in cols and "symbol_accuracy [keypoints]" in cols
+    # Each side is the mean of that path's own rows for the condition.
+    base = [r for r in res.by_capture["keypoints"][0] if r["factor"] == "baseline" and r["split"] == "test"]
+    assert lines[0]["symbol_accuracy [keypoints]"] == pytest.approx(
+        sum(r["symbol_accuracy"] for r in base) / len(base), rel=1e-12
+    )
+    html = (tmp_path / "report.html").read_text()
+    assert "Capture paths compared" in html and "mpjpe" not in cols
