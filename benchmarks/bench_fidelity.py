@@ -1,11 +1,15 @@
 """Benchmark of the comparison maths and the fidelity study.
 
-Run: ``/work/venv/bin/python benchmarks/bench_fidelity.py [--quick-study]``
+Run: ``python benchmarks/bench_fidelity.py [--only] [--video 8] [--workers keypoints] [--quick-study]``
 
 Prints: resampling and DTW speed, seconds per study job on each capture
 path (and the full default study's estimated wall time on this machine's
-cores), and with ``--quick-study`` the wall time of ``c2n fidelity-study
---quick`` and its observer accuracy.  Nothing is asserted.
+cores); with ``--video N`` the seconds of N seeded random jobs of the full
+default grid on the real video path and the full video study's estimate;
+with ``--workers PATH`` the wall time of a small study (24 jobs) with 1 and
+2 local worker processes and the speed-up; with ``--quick-study`` the wall
+time of ``c2n fidelity-study --quick`` and its observer accuracy.  ``--only``
+skips the first three.  Nothing is asserted.
 """
 
 from __future__ import annotations
@@ -77,6 +81,81 @@ def bench_jobs() -> None:
         )
 
 
+def bench_video_sample(n: int = 8, seed: int = 0) -> None:
+    """Seconds per video job on a seeded random sample of the full default grid, and the study's estimate."""
+    from pipelines.fidelity.conditions import build_conditions, build_jobs, phrase_complexity
+    from pipelines.fidelity.config import StudyConfig
+    from pipelines.fidelity.measure import builtin_scores
+    from pipelines.fidelity.runner import run_condition
+
+    cfg = StudyConfig(capture="video")
+    scores = builtin_scores()
+    jobs = build_jobs(cfg, sorted(scores), phrase_complexity(scores), build_conditions(cfg))
+    pick = np.random.default_rng(seed).choice(len(jobs), n, replace=False)
+    secs, cpu = [], []
+    for i in pick:
+        j = jobs[i]
+        t, c = time.perf_counter(), time.process_time()
+        row = run_condition(j, cfg.seed, "video", bootstrap=cfg.bootstrap)
+        secs.append(time.perf_counter() - t)
+        cpu.append(time.process_time() - c)
+        print(
+            f"  video {j.performance.phrase:13s} {j.performance.emotion:6s} {j.condition.label:45s} "
+            f"{row['frames']:4d} frames {secs[-1]:5.1f} s (cpu {cpu[-1]:5.1f} s) {row['error']}"
+        )
+    cores = os.cpu_count() or 1
+    mean, sd = float(np.mean(secs)), float(np.std(secs, ddof=1))
+    print(
+        f"video: {mean:.1f} s per job (sd {sd:.1f}, cpu {np.mean(cpu):.1f} s, n={n}, seeded random sample); full "
+        f"default study on the video path = {len(jobs)} jobs -> ESTIMATED {len(jobs) * mean / cores / 60:.0f} min "
+        f"on {cores} cores (perfect scaling; load {os.getloadavg()[0]:.1f})"
+    )
+
+
+def bench_workers(capture: str = "keypoints", repeats: int = 2) -> None:
+    """Wall time of one small study with 1 and with 2 local worker processes (fresh caches)."""
+    from pipelines.fidelity import StudyConfig, run_study
+
+    cfg = StudyConfig(
+        phrases=("figure7", "port_de_bras"),
+        emotions=("happy", "sad"),
+        takes=2,
+        training_takes=2,
+        capture=capture,
+        frame_rates=(25, 5),
+        resampling=("keyframe",),
+        image_sizes=((320, 240),),
+        views=("front",),
+        compression=(0,),
+        noise=(0.0,),
+        bootstrap=10,
+        baseline={"frame_rate": 25, "image_size": (320, 240), "view": "front", "compression": 0, "noise": 0.0},
+    )
+    import resource
+
+    def cpu() -> float:
+        own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+        return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+    wall = {}
+    for _rep in range(repeats):
+        for w in (1, 2):
+            with tempfile.TemporaryDirectory() as d:
+                load = os.getloadavg()[0]
+                t, c = time.perf_counter(), cpu()
+                res = run_study(cfg, d, workers=w, progress=False)
+                wall.setdefault(w, []).append(time.perf_counter() - t)
+                print(
+                    f"  {capture} study, {res.summary['jobs']['total']} jobs, {w} worker(s): {wall[w][-1]:.1f} s wall, "
+                    f"{cpu() - c:.1f} s CPU (load before {load:.1f})"
+                )
+    best = {w: min(v) for w, v in wall.items()}
+    print(
+        f"speed-up 1 -> 2 local workers ({capture}): {best[1] / best[2]:.2f}x (MEASURED, best of {repeats}; "
+        f"load {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)"
+    )
+
+
 def bench_quick_study() -> None:
     from pipelines.fidelity import load_config, run_fidelity_study
 
@@ -94,10 +173,18 @@ def bench_quick_study() -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick-study", action="store_true", help="also time c2n fidelity-study --quick")
+    ap.add_argument("--video", type=int, default=0, metavar="N", help="time N random video jobs of the full study")
+    ap.add_argument("--workers", choices=("keypoints", "video", "truth"), help="time 1 vs 2 workers on a small study")
+    ap.add_argument("--only", action="store_true", help="skip the resampling, DTW and per-job figures")
     args = ap.parse_args()
-    bench_resample()
-    bench_dtw()
-    bench_jobs()
+    if not args.only:
+        bench_resample()
+        bench_dtw()
+        bench_jobs()
+    if args.video:
+        bench_video_sample(args.video)
+    if args.workers:
+        bench_workers(args.workers)
     if args.quick_study:
         bench_quick_study()
 

@@ -9,25 +9,20 @@ grid (:mod:`.conditions`), runs every job (:mod:`.runner`), and writes
 from __future__ import annotations
 
 from .config import StudyConfig, load_config, quick
+from .measure import CAPTURE_NOTES
+from .pool import StudyInterrupted
 from .runner import STUDY_VERSION, run_condition, run_study
 
-__all__ = ["STUDY_VERSION", "StudyConfig", "load_config", "quick", "run_condition", "run_fidelity_study", "run_study"]
-
-CAPTURE_NOTES = {
-    "truth": "truth path — the virtual dancer's joints projected into each camera, jittered and rounded to pixels, "
-    "lifted back with the true depth (no image, no pose detector, no fitting; compression not modelled)",
-    "keypoints": "keypoint path — the dancer's 33 BlazePose landmarks projected into each camera with self-occlusion, "
-    "jittered and rounded to pixels, then fitted in 3D by capture2notation.fitting with the camera it estimates "
-    "(no image and no pose detector; compression not modelled)",
-    "video": "video path — the renderer draws each take, the kept frames are held in between, JPEG-compressed and "
-    "noised, and c2n capture (BlazePose, fitting, segmentation) reads the video with no calibration",
-}
-CAPTURE_NOTES |= {
-    f"{path}-calibrated": CAPTURE_NOTES[path]
-    .replace(" with the camera it estimates", " with the renderer's camera, calibrated")
-    .replace(" with no calibration", " with the renderer's camera as --calibration")
-    for path in ("keypoints", "video")
-}
+__all__ = [
+    "STUDY_VERSION",
+    "StudyConfig",
+    "StudyInterrupted",
+    "load_config",
+    "quick",
+    "run_condition",
+    "run_fidelity_study",
+    "run_study",
+]
 
 
 def run_fidelity_study(

@@ -11,7 +11,7 @@ take).  Example ``study.toml``::
     emotions = ["happy", "sad", "angry", "afraid"]
     takes = 3                # test performances per phrase and emotion
     training_takes = 3       # separate performances that calibrate the observer
-    capture = "auto"         # "truth", "keypoints", "video", "auto", or "keypoints-calibrated"/"video-calibrated"
+    capture = "auto"         # a capture path or a list of them, e.g. ["video", "keypoints"]
     frame_rates = [25, 12.5, 8.33, 5]
     resampling = ["keyframe", "naive"]
     image_sizes = [[220, 175], [320, 240], [640, 480], [1280, 720]]
@@ -22,6 +22,22 @@ take).  Example ``study.toml``::
     frame_rate = 25
     image_size = [640, 480]
     view = "front"
+
+Capture paths (:mod:`pipelines.fidelity.measure`): ``video`` (render →
+BlazePose → fit, the real perception path), ``keypoints`` (simulated
+BlazePose landmarks with Gaussian world-landmark noise → fit: the named fast
+condition, about 1 s a job against 4-45 s), ``truth``, and the calibrated
+conditions ``keypoints-calibrated`` / ``video-calibrated``.  ``capture`` is
+one of them or a list: every listed path runs the whole grid, the first is
+the primary one (the figures and conclusions of the report) and the report
+compares the paths condition by condition.  ``auto`` is :data:`AUTO_CAPTURE`.
+The video path is not the default because the full default grid (816 jobs)
+on it is estimated at well over the 45-min budget on 2 cores (see
+``docs/benchmarks/scale.md``); run ``capture = ["video", "keypoints"]`` to
+measure real against simulated perception.
+
+Every value is checked for its type and range (:func:`check`): a wrong one
+is a one-line error naming the key and the value.
 """
 
 from __future__ import annotations
@@ -36,8 +52,10 @@ from capture2notation.compare.resample import as_rate
 from capture2notation.errors import PipelineError
 from capture2notation.notation.model import EMOTIONS
 
-__all__ = ["StudyConfig", "load_config", "quick"]
+__all__ = ["AUTO_CAPTURE", "CAPTURES", "StudyConfig", "check", "load_config", "quick"]
 
+#: What ``capture = "auto"`` runs: the simulated-keypoint path (see the module docstring for why not video).
+AUTO_CAPTURE = ("keypoints",)
 CAPTURES = ("auto", "truth", "keypoints", "video", "keypoints-calibrated", "video-calibrated")
 RESAMPLING = ("keyframe", "naive")
 VIEWS = ("front", "45", "side")
@@ -57,8 +75,9 @@ class StudyConfig:
     takes, training_takes : int
         Test performances per phrase × emotion (>= 2 so a "same" trial shows
         two different takes), and separate ones for calibrating the observer.
-    capture : str
-        How a condition is captured (see :mod:`pipelines.fidelity.conditions`).
+    capture : str or tuple of str
+        How a condition is captured: one path of :data:`CAPTURES` or several
+        (the first is the primary one).
     frame_rates : tuple of float
         Hz, from the 25 Hz source.
     resampling : tuple of str
@@ -85,7 +104,7 @@ class StudyConfig:
     emotions: tuple = EMOTIONS
     takes: int = 3
     training_takes: int = 3
-    capture: str = "auto"
+    capture: str | tuple = "auto"
     frame_rates: tuple = (25.0, 12.5, 8.33, 5.0)
     resampling: tuple = RESAMPLING
     image_sizes: tuple = ((220, 175), (320, 240), (640, 480), (1280, 720))
@@ -105,49 +124,106 @@ class StudyConfig:
     bootstrap: int = 30
 
     def __post_init__(self):
-        where = "study config"
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise PipelineError(f"{where}: seed must be a non-negative integer, got {self.seed!r}")
-        for e in self.emotions:
-            if e not in EMOTIONS:
-                raise PipelineError(f"{where}: unknown emotion {e!r}; expected some of {', '.join(EMOTIONS)}")
-        if len(self.emotions) < 2:
-            raise PipelineError(f"{where}: same/different trials need at least 2 emotions, got {list(self.emotions)}")
-        if self.takes < 2 or self.training_takes < 2:
-            raise PipelineError(
-                f"{where}: takes and training_takes must be >= 2, got {self.takes}, {self.training_takes}"
-            )
-        if self.capture not in CAPTURES:
-            raise PipelineError(f"{where}: capture {self.capture!r} must be one of {', '.join(CAPTURES)}")
-        for m in self.resampling:
-            if m not in RESAMPLING:
-                raise PipelineError(f"{where}: resampling {m!r} must be one of {', '.join(RESAMPLING)}")
-        for v in self.views:
-            if v not in VIEWS:
-                raise PipelineError(f"{where}: view {v!r} must be one of {', '.join(VIEWS)}")
-        for r in self.frame_rates:
-            if not 0 < float(r) <= self.source_fps:
-                raise PipelineError(f"{where}: frame rate {r} Hz must lie in (0, {self.source_fps}]")
-        for s in self.image_sizes:
-            if len(s) != 2 or min(s) < 16:
-                raise PipelineError(f"{where}: image size {list(s)} must be [width, height] of at least 16 px")
-        for q in self.compression:
-            if not (q == 0 or 1 <= q <= 100):
-                raise PipelineError(f"{where}: compression quality {q} must be 0 (none) or 1-100")
-        for n in self.noise:
-            if not float(n) >= 0:
-                raise PipelineError(f"{where}: noise sigma {n} must be >= 0")
-        b = self.baseline
-        missing = {"frame_rate", "image_size", "view", "compression", "noise"} - set(b)
-        if missing:
-            raise PipelineError(f"{where}: baseline lacks {', '.join(sorted(missing))}")
-        if b["view"] not in VIEWS:
-            raise PipelineError(f"{where}: baseline view {b['view']!r} must be one of {', '.join(VIEWS)}")
-        as_rate(b["frame_rate"], self.source_fps)
+        if isinstance(self.capture, (list, tuple)):
+            object.__setattr__(self, "capture", tuple(self.capture))
+        check(self)
 
     def as_dict(self) -> dict:
         d = dataclasses.asdict(self)
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_num(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _seq(v) -> bool:
+    return isinstance(v, (tuple, list))
+
+
+#: Per list-valued key: (test of one element, what it must be).
+LIST_KEYS = {
+    "phrases": (lambda x: isinstance(x, str), "a list of phrase names"),
+    "emotions": (lambda x: x in EMOTIONS, f"a list of emotions out of {', '.join(EMOTIONS)}"),
+    "resampling": (lambda x: x in RESAMPLING, f"a list out of {', '.join(RESAMPLING)}"),
+    "views": (lambda x: x in VIEWS, f"a list out of {', '.join(VIEWS)}"),
+    "frame_rates": (lambda x: _is_num(x) and x > 0, "a list of frame rates in Hz (numbers > 0)"),
+    "image_sizes": (
+        lambda x: _seq(x) and len(x) == 2 and all(_is_int(n) and n >= 16 for n in x),
+        "a list of [width, height] pairs of integers >= 16 px",
+    ),
+    "compression": (lambda x: _is_int(x) and (x == 0 or 1 <= x <= 100), "a list of JPEG qualities 1-100 (0 = none)"),
+    "noise": (lambda x: _is_num(x) and x >= 0, "a list of pixel noise sigmas (numbers >= 0)"),
+}
+#: Per integer key: its least value and why.
+INT_KEYS = {"seed": 0, "takes": 2, "training_takes": 2, "bootstrap": 0}
+
+
+def check(cfg: StudyConfig, where: str = "study config") -> None:
+    """Raise a one-line :class:`PipelineError` naming the first key of the wrong type or range and its value."""
+
+    def bad(key, must, value):
+        raise PipelineError(f"{where}: {key} must be {must}, got {value!r}")
+
+    for key, least in INT_KEYS.items():
+        v = getattr(cfg, key)
+        if not _is_int(v) or v < least:
+            # takes >= 2 so that a "same" trial shows two different takes.
+            bad(key, f"an integer >= {least}", v)
+    if not _is_num(cfg.source_fps) or not cfg.source_fps > 0:
+        bad("source_fps", "a number > 0 (Hz)", cfg.source_fps)
+    modes = (cfg.capture,) if isinstance(cfg.capture, str) else cfg.capture
+    must = f"one of {', '.join(CAPTURES)} or a list of them"
+    if not _seq(modes) or not modes:
+        bad("capture", must, cfg.capture)
+    for m in modes:
+        if not (isinstance(m, str) and m in CAPTURES):
+            bad("capture", must, m)
+    for key, (ok, must) in LIST_KEYS.items():
+        v = getattr(cfg, key)
+        if not _seq(v):
+            bad(key, must, v)
+        for x in v:
+            if not ok(x):
+                bad(key, must, x)
+    if len(cfg.emotions) < 2:
+        bad("emotions", "at least 2 emotions (same/different trials)", list(cfg.emotions))
+    for r in cfg.frame_rates:
+        if r > cfg.source_fps:
+            bad("frame_rates", f"at most the source rate {cfg.source_fps:g} Hz", r)
+    b = cfg.baseline
+    if not isinstance(b, dict):
+        bad("baseline", "a table (frame_rate, image_size, view, compression, noise)", b)
+    unknown = sorted(set(b) - set(BASELINE_KEYS))
+    if unknown:
+        bad("baseline", f"a table of {', '.join(BASELINE_KEYS)} only (unknown: {', '.join(unknown)})", b)
+    missing = sorted(set(BASELINE_KEYS) - set(b))
+    if missing:
+        bad("baseline", f"a table with {', '.join(missing)} too", b)
+    for key in BASELINE_KEYS:
+        ok, must = LIST_KEYS[BASELINE_KEYS[key]]
+        if not ok(b[key]):
+            bad(f"baseline.{key}", must.replace("a list of ", "").replace("a list out of ", "one of "), b[key])
+    if b["frame_rate"] > cfg.source_fps:
+        bad("baseline.frame_rate", f"at most the source rate {cfg.source_fps:g} Hz", b["frame_rate"])
+    try:
+        as_rate(b["frame_rate"], cfg.source_fps)
+    except PipelineError as exc:
+        raise PipelineError(f"{where}: baseline.frame_rate: {exc}") from None
+
+
+#: Baseline key → the list key whose element rules it follows.
+BASELINE_KEYS = {
+    "frame_rate": "frame_rates",
+    "image_size": "image_sizes",
+    "view": "views",
+    "compression": "compression",
+    "noise": "noise",
+}
 
 
 def _tuplify(v):
@@ -177,22 +253,28 @@ def load_config(path=None, overrides: dict | None = None) -> StudyConfig:
         except tomllib.TOMLDecodeError as exc:
             raise PipelineError(f"{p}: not valid TOML: {exc}") from None
     data.update(overrides or {})
+    where = str(path) if path is not None else "study config"
     known = {f.name for f in dataclasses.fields(StudyConfig)}
     unknown = sorted(set(data) - known)
     if unknown:
-        where = str(path) if path is not None else "study config"
         raise PipelineError(
             f"{where}: unknown setting(s) {', '.join(unknown)}; expected some of {', '.join(sorted(known))}"
         )
     kw = {}
     for k, v in data.items():
         if k == "baseline":
+            if not isinstance(v, dict):
+                raise PipelineError(f"{where}: baseline must be a table ([baseline] in study.toml), got {v!r}")
             base = dict(StudyConfig().baseline)
-            base.update({bk: _tuplify(bv) for bk, bv in dict(v).items()})
+            base.update({bk: _tuplify(bv) for bk, bv in v.items()})
             kw[k] = base
         else:
             kw[k] = _tuplify(v)
-    return StudyConfig(**kw)
+    try:
+        return StudyConfig(**kw)
+    except PipelineError as exc:
+        msg = str(exc)
+        raise PipelineError(where + msg[len("study config") :] if msg.startswith("study config") else msg) from None
 
 
 def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:

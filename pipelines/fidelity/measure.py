@@ -50,6 +50,7 @@ from capture2notation.notation.model import PART_SEGMENTS, Score
 from .conditions import Condition, Performance, take_variation
 
 __all__ = [
+    "CAPTURE_NOTES",
     "DETECTOR_FLOOR_PX",
     "capture",
     "estimate_effort",
@@ -67,6 +68,24 @@ DETECTOR_FLOOR_PX = 1.0
 #: Noise (m) of the simulated BlazePose world landmarks on the keypoint path,
 #: our stated assumption (MediaPipe's own test tolerance is 0.2 m).
 WORLD_NOISE_M = 0.03
+
+
+#: One sentence per capture path, for the report.
+CAPTURE_NOTES = {
+    "truth": "truth path — the virtual dancer's joints projected into each camera, jittered and rounded to pixels, "
+    "lifted back with the true depth (no image, no pose detector, no fitting; compression not modelled)",
+    "keypoints": "keypoint path — the dancer's 33 BlazePose landmarks projected into each camera with self-occlusion, "
+    "jittered and rounded to pixels, then fitted in 3D by capture2notation.fitting with the camera it estimates "
+    "(no image and no pose detector; compression not modelled)",
+    "video": "video path — the renderer draws each take, the kept frames are held in between, JPEG-compressed and "
+    "noised, and c2n capture (BlazePose, fitting, segmentation) reads the video with no calibration",
+}
+CAPTURE_NOTES |= {
+    f"{path}-calibrated": CAPTURE_NOTES[path]
+    .replace(" with the camera it estimates", " with the renderer's camera, calibrated")
+    .replace(" with no calibration", " with the renderer's camera as --calibration")
+    for path in ("keypoints", "video")
+}
 
 
 def builtin_scores() -> dict[str, Score]:

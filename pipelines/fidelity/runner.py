@@ -1,10 +1,11 @@
 """Run a fidelity study: every job in parallel, cached, then the same/different trials.
 
 Jobs run on local processes by default (one per core, with a progress bar)
-or on a Dask distributed cluster (``scheduler`` address).  Each finished job
-is cached as ``cache/<hash>.json`` in the output folder, the hash covering
-the job's whole configuration and the code version, so an interrupted study
-resumes where it stopped.  Every random draw is seeded from the study seed
+or on a Dask distributed cluster (``scheduler`` address), see :mod:`.pool`.
+Each job is cached atomically as ``cache/<hash>.json`` in the output folder
+as soon as it finishes, the hash covering the job's whole configuration and
+the code version, so an interrupted study resumes where it stopped; a cache
+file that is not such a row is rerun with a warning.  Every random draw is seeded from the study seed
 and the job's identity (not its position in a queue), so the same seed gives
 the same ``results.csv`` however the jobs are scheduled.
 """
@@ -17,8 +18,8 @@ import json
 import logging
 import math
 import os
+import signal
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict
 from fractions import Fraction
 from pathlib import Path
@@ -38,15 +39,24 @@ from capture2notation.compare.discrimination import (
 from capture2notation.errors import C2NError, PipelineError
 
 from .conditions import Condition, Job, build_conditions, build_jobs, phrase_complexity, stable_seed
-from .config import StudyConfig
+from .config import AUTO_CAPTURE, StudyConfig
 from .measure import builtin_scores, capture, kept_frames, measure, perform
+from .pool import StudyInterrupted, _Stop, execute, signal_of, stop_on_signals
 
-__all__ = ["STUDY_VERSION", "StudyResult", "resolve_capture", "run_condition", "run_study"]
+__all__ = [
+    "STUDY_VERSION",
+    "StudyInterrupted",
+    "StudyResult",
+    "load_cached",
+    "resolve_capture",
+    "run_condition",
+    "run_study",
+]
 
 log = logging.getLogger(__name__)
 
 #: Bumped when the measurement changes, so cached jobs are recomputed.
-STUDY_VERSION = f"{__version__}-fidelity-3"
+STUDY_VERSION = f"{__version__}-fidelity-4"
 
 #: Capture paths without images (compression cannot be applied).
 IMAGE_FREE = ("truth", "keypoints")
@@ -70,9 +80,10 @@ ID_COLUMNS = (
 )
 
 
-def resolve_capture(mode: str) -> str:
-    """The capture path to use: ``auto`` is the keypoint path (projected landmarks, then 3D fitting)."""
-    return "keypoints" if mode == "auto" else mode
+def resolve_capture(capture) -> tuple[str, ...]:
+    """The capture paths to run, the primary first: ``auto`` is :data:`~.config.AUTO_CAPTURE`."""
+    modes = (capture,) if isinstance(capture, str) else tuple(capture)
+    return tuple(dict.fromkeys(m for mode in modes for m in (AUTO_CAPTURE if mode == "auto" else (mode,))))
 
 
 def run_condition(
@@ -123,60 +134,70 @@ def run_condition(
 
 
 def _job_worker(args):
-    job, seed, mode, fps, bootstrap = args
-    return run_condition(job, seed, mode, fps, bootstrap)
+    job, seed, mode, fps, bootstrap, digest = args
+    return run_condition(job, seed, mode, fps, bootstrap) | {"job": digest}
 
 
 class StudyResult:
-    """Rows of a finished study and its discrimination summary."""
+    """Rows of a finished study and its discrimination summary.
 
-    def __init__(self, rows, trials, summary, conditions, wall_seconds):
+    ``rows``, ``trials``, ``summary`` and ``conditions`` are those of the
+    primary (first) capture path; ``by_capture`` maps every capture path run
+    to its own ``(rows, trials, summary, conditions)``.
+    """
+
+    def __init__(self, rows, trials, summary, conditions, wall_seconds, by_capture=None):
         self.rows = rows
         self.trials = trials
         self.summary = summary
         self.conditions = conditions
         self.wall_seconds = wall_seconds
+        self.by_capture = by_capture or {summary.get("capture"): (rows, trials, summary, conditions)}
 
 
-def _cache_path(outdir: Path, job: Job, cfg: StudyConfig, mode: str) -> Path:
-    return outdir / "cache" / f"{job.digest(cfg, mode, STUDY_VERSION)}.json"
+def _cache_path(outdir: Path, digest: str) -> Path:
+    return outdir / "cache" / f"{digest}.json"
 
 
-def _execute(pending, cfg, mode, scheduler, workers, progress, timeout=20.0):
-    """Yield (job, row) as jobs finish, locally or on a Dask cluster."""
-    from capture2notation.progress import progress as progress_bar
+#: Keys every cached result row carries (the job's identity, its outcome, its cache key).
+ROW_KEYS = frozenset(ID_COLUMNS) - {"factor"} | {"error", "seconds", "job"}
 
-    args = [(j, cfg.seed, mode, cfg.source_fps, cfg.bootstrap) for j in pending]
-    bar = progress_bar(total=len(args), desc="fidelity study", unit="job", enabled=progress)
+
+def load_cached(path: Path, digest: str, job: Job, mode: str) -> dict | None:
+    """The cached row of a job, or None (with a warning) when the file cannot be trusted.
+
+    A file that is not JSON, JSON that is not a result row, or a row of
+    another job, configuration or code version (its ``job`` key differs from
+    the file's name) is rerun, never used.
+    """
+    if not path.exists():
+        return None
     try:
-        if scheduler:
-            from dask.distributed import Client
-            from dask.distributed import as_completed as dask_completed
+        row = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        log.warning("cache file %s is unreadable (%s); rerunning its job", path, exc)
+        return None
+    if not isinstance(row, dict) or not set(row) >= ROW_KEYS:
+        what = f"keys {sorted(row)[:6]}" if isinstance(row, dict) else type(row).__name__
+        log.warning("cache file %s is not a result row (%s); rerunning its job", path, what)
+        return None
+    p = job.performance
+    mine = row["job"] == digest and row["capture"] == mode
+    mine = mine and (row["phrase"], row["emotion"], row["take"], row["split"]) == (p.phrase, p.emotion, p.take, p.split)
+    if not mine:
+        log.warning("cache file %s holds another job's row (job %r); rerunning its job", path, row["job"])
+        return None
+    return row
 
-            try:
-                client = Client(scheduler, timeout=f"{timeout}s")
-            except (OSError, TimeoutError) as exc:
-                raise PipelineError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}") from None
-            try:
-                futures = client.map(_job_worker, args, pure=False)
-                index = {f.key: i for i, f in enumerate(futures)}
-                for fut in dask_completed(futures):
-                    yield pending[index[fut.key]], fut.result()
-                    bar.update()
-            finally:
-                client.close()
-        elif workers == 1 or len(args) <= 1:
-            for j, a in zip(pending, args):
-                yield j, _job_worker(a)
-                bar.update()
-        else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futs = {pool.submit(_job_worker, a): j for j, a in zip(pending, args)}
-                for fut in as_completed(futs):
-                    yield futs[fut], fut.result()
-                    bar.update()
-    finally:
-        bar.close()
+
+def _stopped(exc: BaseException, outdir: Path, finished: int, total: int) -> StudyInterrupted:
+    signum = signal_of(exc)
+    name = signal.Signals(signum).name if signum else "signal"
+    return StudyInterrupted(
+        f"interrupted by {name}: {finished} of {total} jobs are finished and kept in {outdir / 'cache'}; "
+        "run the same command again to resume",
+        signum or int(signal.SIGINT),
+    )
 
 
 def run_study(
@@ -201,58 +222,90 @@ def run_study(
         Show a tqdm progress bar.
     connect_timeout : float
         Seconds to wait for the Dask scheduler.
+
+    Raises
+    ------
+    StudyInterrupted
+        On Ctrl-C or SIGTERM, within about a second, after every finished job
+        was cached and the worker processes were killed.
     """
+    from capture2notation.progress import progress as progress_bar
+
     t0 = time.perf_counter()
     outdir = Path(outdir)
-    mode = resolve_capture(cfg.capture)
+    modes = resolve_capture(cfg.capture)
     scores = builtin_scores()
     names = tuple(cfg.phrases) or tuple(sorted(scores))
     missing = [n for n in names if n not in scores]
     if missing:
         raise PipelineError(f"unknown phrase(s) {', '.join(missing)}; built-in phrases are {', '.join(sorted(scores))}")
     complexity = phrase_complexity({n: scores[n] for n in (tuple(sorted(scores)))})
-    conditions = build_conditions(cfg)
-    if mode in IMAGE_FREE:
-        # No image on these paths: a compression level would silently equal the baseline.
-        conditions = [c for c in conditions if c.compression == 0]
-    jobs = build_jobs(cfg, names, complexity, conditions)
+    grid = {}
+    for mode in modes:
+        conditions = build_conditions(cfg)
+        if mode in IMAGE_FREE:
+            # No image on these paths: a compression level would silently equal the baseline.
+            conditions = [c for c in conditions if c.compression == 0]
+        grid[mode] = (conditions, build_jobs(cfg, names, complexity, conditions))
     rows_by_job: dict = {}
     pending = []
-    for j in jobs:
-        path = _cache_path(outdir, j, cfg, mode)
-        if path.exists():
-            try:
-                rows_by_job[j] = json.loads(path.read_text(encoding="utf-8"))
-                continue
-            except (OSError, json.JSONDecodeError):
-                log.warning("ignoring unreadable cache file %s", path)
-        pending.append(j)
-    log.info("%d jobs, %d cached, %d to run (capture=%s)", len(jobs), len(jobs) - len(pending), len(pending), mode)
-    workers = workers or os.cpu_count() or 1
-    for j, row in _execute(pending, cfg, mode, scheduler, workers, progress, connect_timeout):
-        write_text(_cache_path(outdir, j, cfg, mode), json.dumps(row, sort_keys=True, default=_json_default))
-        rows_by_job[j] = row
-    # Condition identity (not its factor label) keys the cache; restore the label here.
-    rows = []
-    for j in jobs:
-        r = dict(rows_by_job[j])
-        r["factor"] = j.condition.factor
-        rows.append(r)
-    trials, summary = discrimination(rows, cfg, conditions)
-    write_text(outdir / "results.csv", rows_to_csv(rows))
-    write_text(outdir / "trials.csv", rows_to_csv(trials))
-    wall = time.perf_counter() - t0
-    summary["config"] = cfg.as_dict()
-    summary["capture"] = mode
-    summary["jobs"] = {
-        "total": len(jobs),
-        "ran": len(pending),
-        "cached": len(jobs) - len(pending),
-        "failed": sum(1 for r in rows if r.get("error")),
-        "job_seconds": float(sum(r.get("seconds", 0.0) for r in rows)),
-    }
+    for mode, (_conds, jobs) in grid.items():
+        for j in jobs:
+            digest = j.digest(cfg, mode, STUDY_VERSION)
+            row = load_cached(_cache_path(outdir, digest), digest, j, mode)
+            if row is None:
+                pending.append((mode, j, digest))
+            else:
+                rows_by_job[(mode, j)] = row
+    total = sum(len(jobs) for _c, jobs in grid.values())
+    log.info("%d jobs, %d cached, %d to run (capture=%s)", total, total - len(pending), len(pending), ",".join(modes))
+
+    def keep(i, row):
+        mode, j, digest = pending[i]
+        write_text(_cache_path(outdir, digest), json.dumps(row, sort_keys=True, default=_json_default))
+        rows_by_job[(mode, j)] = row
+
+    args = [(j, cfg.seed, mode, cfg.source_fps, cfg.bootstrap, digest) for mode, j, digest in pending]
+    bar = progress_bar(total=len(args), desc="fidelity study", unit="job", enabled=progress)
+    try:
+        with stop_on_signals():
+            execute(
+                _job_worker,
+                args,
+                keep,
+                scheduler=scheduler,
+                workers=workers or os.cpu_count() or 1,
+                timeout=connect_timeout,
+                on_progress=bar.update,
+            )
+    except (KeyboardInterrupt, _Stop) as exc:
+        raise _stopped(exc, outdir, len(rows_by_job), total) from None
+    finally:
+        bar.close()
+    by_capture = {}
+    for mode, (conditions, jobs) in grid.items():
+        # Condition identity (not its factor label) keys the cache; restore the label here.
+        rows = [dict(rows_by_job[(mode, j)], factor=j.condition.factor) for j in jobs]
+        trials, summary = discrimination(rows, cfg, conditions)
+        for t in trials:
+            t["capture"] = mode
+        summary["config"] = cfg.as_dict()
+        summary["capture"] = mode
+        summary["jobs"] = {
+            "total": len(jobs),
+            "ran": sum(1 for m, _j, _d in pending if m == mode),
+            "failed": sum(1 for r in rows if r.get("error")),
+            "job_seconds": float(sum(r.get("seconds", 0.0) for r in rows)),
+        }
+        summary["jobs"]["cached"] = len(jobs) - summary["jobs"]["ran"]
+        by_capture[mode] = (rows, trials, summary, conditions)
+    rows, trials, summary, conditions = by_capture[modes[0]]
+    if len(modes) > 1:
+        summary["other_captures"] = {m: by_capture[m][2] for m in modes[1:]}
+    write_text(outdir / "results.csv", rows_to_csv([r for m in modes for r in by_capture[m][0]]))
+    write_text(outdir / "trials.csv", rows_to_csv([t for m in modes for t in by_capture[m][1]]))
     write_text(outdir / "summary.json", json.dumps(summary, indent=2, sort_keys=True, default=_json_default))
-    return StudyResult(rows, trials, summary, conditions, wall)
+    return StudyResult(rows, trials, summary, conditions, time.perf_counter() - t0, by_capture)
 
 
 def _json_default(o):
@@ -278,7 +331,7 @@ def rows_to_csv(rows: list[dict]) -> str:
     if not rows:
         return ""
     cols = [c for c in ID_COLUMNS if any(c in r for r in rows)]
-    rest = sorted({k for r in rows for k in r} - set(cols) - {"seconds"})
+    rest = sorted({k for r in rows for k in r} - set(cols) - {"seconds", "job"})
     cols += rest
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")

@@ -47,7 +47,7 @@ def test_config_from_toml_and_errors(tmp_path):
         load_config(p)
     with pytest.raises(PipelineError, match="takes"):
         StudyConfig(takes=1)
-    with pytest.raises(PipelineError, match="view 'top'"):
+    with pytest.raises(PipelineError, match=r"views .*'top'"):
         StudyConfig(views=("top",))
 
 
