@@ -28,6 +28,7 @@ import html
 import json
 import re
 from pathlib import Path
+from urllib.parse import quote
 
 from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW, Score
 from capture2notation.notation.staff import staff_layout, svg_text
@@ -166,10 +167,10 @@ def _videos(names: list[str]) -> str:
     figures = []
     for i, name in enumerate(names):
         role = "lead" if i == 0 else "follow"
-        caption = f"{name}: the playhead follows it" if i == 0 else f"{name}: in step with {names[0]}"
+        caption = f"{name} (the playhead follows it)" if i == 0 else name
         extra = " controls" if i == 0 else ""
         figures.append(
-            f'<figure class="{role}"><video class="capture-video" src="{html.escape(name)}"{extra} loop muted '
+            f'<figure class="{role}"><video class="capture-video" src="{html.escape(quote(name))}"{extra} loop muted '
             f'playsinline preload="auto"></video><figcaption>{html.escape(caption)}</figcaption></figure>'
         )
     single = " single" if len(names) == 1 else ""
@@ -299,9 +300,14 @@ tr.now td {{ background: #ffe9a8; }}
 #staff g.symbol.now polygon {{ stroke: {PLAYHEAD_COLOUR}; stroke-width: 2.5; }}
 .plots img {{ max-width: 48%; }}
 @media (max-width: {SIDE_BY_SIDE_MIN_PX - 1}px) {{
-  .row {{ display: block; height: auto; min-height: 0; }}
-  .staff-pane {{ max-height: 70vh; margin-bottom: 1em; }}
-  .table-box {{ max-height: 60vh; }}
+  /* Stacked: the video, where the playhead is, the staff, then the symbols. */
+  .row {{ flex-direction: column; gap: 0.4em; height: auto; min-height: 0; }}
+  .side {{ display: contents; }}
+  .videos {{ order: 1; }} .clock {{ order: 2; }} .staff-pane {{ order: 3; }}
+  .uncertain-count {{ order: 4; }} .table-box {{ order: 5; }}
+  .videos figure.lead video {{ max-height: 35vh; }}
+  .staff-pane {{ flex: 0 0 auto; max-height: 55vh; }}
+  .table-box {{ flex: 0 0 auto; max-height: 60vh; }}
 }}
 """
 
