@@ -18,7 +18,8 @@ written atomically into OUTDIR:
                     JSON) and which camera the fit used (``camera_source``)
 ``effort.json``     Laban Effort with uncertainty (and its plots)
 ``overlay.mp4``     the video with the keypoints drawn (video input)
-``index.html``      the staff beside the overlay video
+``index.html``      the staff beside the overlay video, with a playhead
+                    (:mod:`pipelines.capture_page`)
 ==================  ==========================================================
 
 The tempo is given (``tempo=``), ``"none"`` (60 bpm: one beat a second),
@@ -35,7 +36,6 @@ camera from the person.  Files lying beside the input are never read.
 
 from __future__ import annotations
 
-import html
 import json
 import logging
 import os
@@ -53,7 +53,7 @@ from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS, joint_index
 from capture2notation.errors import C2NError, PipelineError, QuantiseError
 from capture2notation.fitting.motion import joints_for_labels
-from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW, Score
+from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.confidence import score_confidence
 from capture2notation.quantise.labels import write_labels_csv
@@ -62,6 +62,7 @@ from capture2notation.quantise.segment import (
     SegmentParams,
     segment_motion,
 )
+from pipelines.capture_page import index_html
 
 __all__ = [
     "MOTION_SUFFIXES",
@@ -522,11 +523,6 @@ def _write_effort(outdir: Path, score: Score, motion, seed: int) -> dict:
     return {Path(p).name: Path(p) for p in paths.values()}
 
 
-def _interval(d: dict) -> str:
-    lo, hi = d["ci90"]
-    return f"{d['median']:.2f} [{lo:.2f}, {hi:.2f}]"
-
-
 def _sound_evidence(path, fps: float):
     """The beat of a video's sound track as tempo evidence, and what became of it (for the page).
 
@@ -585,121 +581,3 @@ def tempo_note(seg, sound: str = "") -> str:
     other = f"; else {seg.tempo_runner_up} bpm" if seg.tempo_runner_up is not None else ""
     why = f"; {sound}" if sound else ""
     return f" (estimated from {source}{sure}{other}{why}; give --tempo to fix it)"
-
-
-def emotion_line(data: dict) -> str:
-    """The emotion of an ``effort.json`` in words: the reading, or why it is not read."""
-    if data.get("emotion_text"):
-        return str(data["emotion_text"])
-    emotion = data.get("emotion") or {}
-    if not emotion:
-        return "not read"
-    return " · ".join(f"{k} {v:.0%}" for k, v in sorted(emotion.items(), key=lambda kv: -kv[1]))
-
-
-def _effort_html(files: dict) -> str:
-    """The Effort section of the index page: pooled estimate, emotion, plots."""
-    if "effort.json" not in files:
-        return ""
-    data = json.loads(Path(files["effort.json"]).read_text(encoding="utf-8"))
-    pooled = data.get("pooled") or {}
-    rows = "".join(
-        f"<tr><td>{name}</td><td>{_interval(pooled[key])}</td></tr>"
-        for key, name in (("time", "Time b"), ("weight", "Weight x0"), ("space", "Space S"))
-        if key in pooled
-    )
-    feelings = html.escape(emotion_line(data))
-    converged = (
-        "all converged"
-        if all(m.get("converged") for m in data.get("movements", []))
-        else ("some posteriors did not converge (see effort.json)")
-    )
-    plots = "".join(
-        f'<img src="{name}" alt="{alt}" style="max-width: 48%">'
-        for name, alt in (
-            ("effort_progress.png", "progress curves with posterior bands"),
-            ("effort_pooled.png", "pooled Effort posterior"),
-        )
-        if name in files
-    )
-    return f"""<h2>Laban Effort (median and 90 % interval)</h2>
-<p>{pooled.get("n_movements", 0)} movements pooled, {converged}.</p>
-<p class="emotion">Emotion: {feelings}.</p>
-<table><tr><th>factor</th><th>estimate</th></tr>{rows}</table>
-<div>{plots}</div>"""
-
-
-UNCERTAIN_ROW = ' class="uncertain"'
-
-
-def _confidence_cell(s) -> str:
-    if s.confidence is None:
-        return ""
-    return f"{s.confidence:.2f}" + (" uncertain" if s.uncertain else "")
-
-
-def index_html(result: CaptureResult) -> str:
-    """A self-contained page: the staff beside the overlay video, the symbols and the files."""
-    score = result.score
-    rows = "\n".join(
-        f"<tr{UNCERTAIN_ROW if s.uncertain else ''}><td>{s.start}</td>"
-        f"<td>{score.seconds(s.start):.2f}</td><td>{s.duration}</td><td>{html.escape(s.part)}</td>"
-        f"<td>{html.escape(s.direction)}</td><td>{html.escape(s.level or '')}</td>"
-        f"<td>{s.bend or (f'amount={s.amount}' if s.amount is not None else '')}</td>"
-        f"<td>{_confidence_cell(s)}</td></tr>"
-        for s in score.symbols
-    )
-    n_uncertain = sum(s.uncertain for s in score.symbols)
-    video = (
-        '<video src="overlay.mp4" controls loop muted playsinline width="100%"></video>'
-        if "overlay.mp4" in result.files
-        else "<p>No video: the input was a motion file.</p>"
-    )
-    links = " · ".join(
-        f'<a href="{html.escape(n)}">{html.escape(n)}</a>' for n in sorted(result.files) if n != "index.html"
-    )
-    tempo = f"{score.tempo} bpm{result.tempo_text}"
-    skipped = "".join(f"<li>{html.escape(s)}</li>" for s in result.skipped)
-    timing = ", ".join(f"{k} {v:.1f} s" for k, v in result.seconds.items())
-    effort = _effort_html(result.files)
-    camera = ""
-    if result.track is not None:
-        est = result.camera_estimate
-        said = est.line() if est is not None else "camera not estimated: the feet and body were seen in too few frames"
-        used = (
-            "the fit used the camera of the " + result.camera_source
-            if result.camera_source.startswith("calibration")
-            else "the fit estimated its own camera (no calibration given)"
-        )
-        camera = f"<p>{html.escape(said)}; {html.escape(used)}.</p>"
-    return f"""<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>Capture: {html.escape(score.title)}</title>
-<style>
-body {{ font-family: sans-serif; margin: 1.5em; }}
-.row {{ display: flex; gap: 2em; align-items: flex-start; }}
-.staff {{ flex: 0 0 auto; max-height: 90vh; overflow-y: auto; }}
-.video {{ flex: 1 1 480px; max-width: 720px; }}
-table {{ border-collapse: collapse; }} td, th {{ padding: 0.1em 0.6em; border-bottom: 1px solid #ddd; }}
-tr.uncertain td {{ color: #777; font-style: italic; }}
-</style></head><body>
-<h1>Capture: {html.escape(score.title)}</h1>
-<p>{result.n_frames} frames at {float(result.motion.fps):g} fps · input: {html.escape(result.kind)} ·
-tempo {html.escape(tempo)} · meter {score.meter} · {len(score.symbols)} symbols</p>
-{camera}
-<div class="row">
-<div class="staff"><img src="staff.svg" alt="Labanotation staff of the captured score"></div>
-<div class="video">{video}
-<h2>Symbols</h2>
-<p class="uncertain-count">{n_uncertain} of {len(score.symbols)} symbols uncertain (confidence below
-{SYMBOL_UNCERTAIN_BELOW:g}; grey and dashed on the staff).</p>
-<table><tr><th>start (beat)</th><th>start (s)</th><th>duration</th><th>part</th><th>direction</th><th>level</th>
-<th>bend</th><th>confidence</th></tr>
-{rows}
-</table></div></div>
-{effort}
-<h2>Files</h2><p>{links}</p>
-{"<h2>Not written</h2><ul>" + skipped + "</ul>" if skipped else ""}
-<p>Time: {html.escape(timing)}</p>
-<script type="application/json" id="summary">{html.escape(json.dumps({"tempo": str(score.tempo), "symbols": len(score.symbols), "uncertain": n_uncertain}))}</script>
-</body></html>
-"""

@@ -59,6 +59,7 @@ __all__ = [
     "FrontSign",
     "Glyph",
     "StaffLayout",
+    "StaffSpan",
     "staff_layout",
     "symbol_outline",
     "turn_outline",
@@ -134,12 +135,41 @@ class FrontSign:
         return float(self.front % 1) * 360.0
 
 
+@dataclass(frozen=True)
+class StaffSpan:
+    """Where one staff's beats lie on the page: beat ``b`` of it is at ``y = y_first - (b - first) * beat_height``.
+
+    Attributes
+    ----------
+    first, last : Fraction
+        The staff's first and last beat (its bottom and top).
+    x_left, x_right : float
+        The staff's outer column edges, pixels.
+    y_first : float
+        Pixel y of beat `first` (y grows downwards: later beats are higher).
+    beat_height : float
+        Pixels per beat.
+    """
+
+    first: Fraction
+    last: Fraction
+    x_left: float
+    x_right: float
+    y_first: float
+    beat_height: float
+
+    def y(self, beat) -> float:
+        """Pixel y of `beat` on this staff (not clipped to it)."""
+        return self.y_first - float(Fraction(beat) - self.first) * self.beat_height
+
+
 @dataclass
 class StaffLayout:
-    """Everything to draw, in pixels (x right, y down)."""
+    """Everything to draw, in pixels (x right, y down); `staves` maps beats to positions."""
 
     width: float
     height: float
+    staves: list = field(default_factory=list)  # StaffSpan, left to right
     glyphs: list = field(default_factory=list)
     lines: list = field(default_factory=list)  # (x0, y0, x1, y1, stroke width)
     texts: list = field(default_factory=list)  # (x, y, text, size, anchor)
@@ -353,6 +383,8 @@ def staff_layout(
     for j in range(n_staves):
         cx = centre(j)
         b0, b1 = j * staff_beats, min(total, (j + 1) * staff_beats)
+        edges = (cx - n_left * column_width, cx + n_right * column_width)
+        lay.staves.append(StaffSpan(Fraction(b0), Fraction(b1), *edges, y(b0, j), beat_height))
         for x in (cx - half, cx, cx + half):
             lay.lines.append((x, y(b0, j), x, y(b1, j), 1.4))
         for b in range(b0, b1 + 1):

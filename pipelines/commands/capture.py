@@ -103,8 +103,9 @@ def capture(
 
     from capture2notation.errors import PipelineError
     from capture2notation.quantise.segment import SegmentParams
-    from pipelines.capture import NO_TEMPO, emotion_line
+    from pipelines.capture import NO_TEMPO
     from pipelines.capture import capture as run
+    from pipelines.capture_page import emotion_line
 
     try:
         step = Fraction(grid)

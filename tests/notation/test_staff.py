@@ -214,6 +214,22 @@ def test_long_scores_continue_on_further_staves():
         staff_layout(score, measures_per_staff=0)
 
 
+def test_staff_spans_place_beats_where_they_are_drawn():
+    """Each staff's span puts a beat on the tick or bar line drawn for it, and a symbol's foot on its start."""
+    score = Score(symbols=(Symbol(0, 3, "head", "forward", "high"), Symbol(5, 4, "right_arm", "right", "low")), meter=2)
+    lay = staff_layout(score, beat_height=10.0, measures_per_staff=2)  # 5 measures: beats 0-4, 4-8, 8-10
+    assert [(s.first, s.last) for s in lay.staves] == [(0, 4), (4, 8), (8, 10)]
+    for span in lay.staves:
+        across = [ln for ln in lay.lines if ln[1] == ln[3] and span.x_left <= ln[0] and ln[2] <= span.x_right]
+        for b in range(int(span.first), int(span.last) + 1):
+            assert any(abs(ln[1] - span.y(b)) < 1e-9 for ln in across), (span, b)
+        centre = [ln for ln in lay.lines if ln[0] == ln[2] and span.x_left < ln[0] < span.x_right]
+        assert len(centre) == 3  # the staff's three lines lie between its outer edges
+    arm = next(g for g in lay.glyphs if g.symbol.part == "right_arm")
+    assert arm.foot[1] == pytest.approx(lay.staves[1].y(5))
+    assert lay.staves[1].x_left < arm.foot[0] < lay.staves[1].x_right
+
+
 def test_empty_score_still_draws_a_staff(tmp_path):
     root = ET.parse(render_staff(Score(), tmp_path / "e.svg")).getroot()
     assert _symbol_groups(root) == []

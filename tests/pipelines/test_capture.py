@@ -87,7 +87,7 @@ def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
         assert float(z["fps"]) == 25.0
         assert np.all(np.isnan(z["keypoints"]))  # no video: no keypoints, none invented
     page = (out / "index.html").read_text()
-    assert 'src="staff.svg"' in page and "motion file" in page
+    assert '<svg id="staff"' in page and 'href="staff.svg"' in page and "motion file" in page
     assert any("overlay.mp4" in s for s in res.skipped)
     # Nothing half-written is left behind.
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
