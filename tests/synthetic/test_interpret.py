@@ -368,3 +368,30 @@ def test_random_scores_are_valid_and_reproducible():
     assert random_score(np.random.default_rng(1)) != random_score(np.random.default_rng(2))
     with pytest.raises(SyntheticError, match="Generator"):
         random_score(1)
+
+
+def test_weight_arrives_on_both_feet_before_the_next_support_moves_it():
+    # DESIGN.md: a movement begins at its start.  `support` ending at beat 2
+    # arrives on both feet; the transfer onto the left foot belongs to the
+    # `left_support` starting then, even though the right leg gestures from 2.
+    from capture2notation.compare.agreement import score_differences
+    from capture2notation.quantise.segment import segment_motion
+
+    score = Score(
+        (
+            Symbol(0, 1, "right_support", "place", "low"),
+            Symbol(1, 1, "left_leg", "left_forward", "middle", 1),
+            Symbol(2, 1, "support", "place", "middle"),
+            Symbol(3, 1, "left_support", "place", "low"),
+            Symbol(3, 1, "right_leg", "right", "low"),
+        ),
+        tempo=80,
+    )
+    fps = 25.0
+    m, J = assert_round_trip(score, fps)
+    f = round(3 * 60 / score.tempo * fps)
+    pelvis, right, left = J[f, _j("pelvis"), 0], J[f, _j("right_ankle"), 0], J[f, _j("left_ankle"), 0]
+    # Midway between the feet (the quantiser's "over a foot" is within a quarter of the way).
+    assert (pelvis - right) / (left - right) == pytest.approx(0.5, abs=0.05)
+    seg = segment_motion(J, fps, tempo=score.tempo)
+    assert score_differences(score, seg.score) == []
