@@ -388,7 +388,7 @@ def test_weight_arrives_on_both_feet_before_the_next_support_moves_it():
         tempo=80,
     )
     fps = 25.0
-    m, J = assert_round_trip(score, fps)
+    _, J = assert_round_trip(score, fps)
     f = round(3 * 60 / score.tempo * fps)
     pelvis, right, left = J[f, _j("pelvis"), 0], J[f, _j("right_ankle"), 0], J[f, _j("left_ankle"), 0]
     # Midway between the feet (the quantiser's "over a foot" is within a quarter of the way).
