@@ -193,10 +193,13 @@ def video(n: int, seed0: int = 20261400) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=30)
+    ap.add_argument(
+        "--seed0", type=int, default=20260000, help="first seed (development: 20260000; fresh: e.g. 20270000)"
+    )
     ap.add_argument("--video", type=int, default=0, help="random scores to render and capture from video")
     ap.add_argument("--skip-bvh", action="store_true")
     args = ap.parse_args()
-    round_trip(args.seeds)
+    round_trip(args.seeds, args.seed0)
     kinect()
     if not args.skip_bvh:
         bvh()

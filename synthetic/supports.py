@@ -93,18 +93,25 @@ def _foot_events(score: Score, foot: str):
     return sup, ges, airs
 
 
-def _planted_after(sup, ges, airs, beat) -> bool:
-    """Whether a foot bears weight just after `beat`.
+def _planted_after(sup, ges, airs, beat, arriving: bool = False) -> bool:
+    """Whether a foot bears weight just after `beat` (or, `arriving`, at it).
 
     Feet start planted; a gesture of the leg frees the foot from its start, a
     support symbol plants it at its end; at a tie the gesture wins.  A
     flight frees the feet after its start (at the take-off beat itself they
     still bear the weight they push off with), and so does a gesture that
-    begins with the flight (the take-off leg of a leap).
+    begins with the flight (the take-off leg of a leap).  `arriving`: the
+    weight a support symbol ending at `beat` arrives on, which a gesture
+    beginning at `beat` has not yet taken off the foot (DESIGN.md: a
+    movement begins at its start, so the weight leaves the foot after it).
     """
     take_offs = {a.start for a in airs}
     effects = [(s.end, 0, True) for s in sup if s.end <= beat]
-    effects += [(g.start, 1, False) for g in ges if g.start < beat or (g.start == beat and beat not in take_offs)]
+    effects += [
+        (g.start, 1, False)
+        for g in ges
+        if g.start < beat or (g.start == beat and beat not in take_offs and not arriving)
+    ]
     effects += [(a.start, 1, False) for a in airs if a.start < beat]
     return max(effects)[2] if effects else True
 
@@ -133,19 +140,20 @@ def foot_lift(tau, seconds: float, height: float):
     return np.clip(np.minimum(FOOT_CONTACT_SPEED * t, FOOT_CONTACT_SPEED * (seconds - t)), 0.0, height)
 
 
-def _weight_feet(sups, events, beat) -> list:
-    """Feet bearing the weight just after `beat`.
+def _weight_feet(sups, events, beat, arriving: bool = False) -> list:
+    """Feet bearing the weight just after `beat` (`arriving`: at `beat`).
 
     Those named by the support symbols in force at `beat` (begun before it,
-    not yet ended), less feet whose leg starts a gesture by then; with no
-    support symbol in force, every planted foot; none in flight.
+    not yet ended), less feet whose leg starts a gesture by then (`arriving`:
+    before it); with no support symbol in force, every planted foot; none
+    in flight.
     """
     if any(s.is_air and s.start < beat <= s.end for s in sups):
         return []
     named = {f for s in sups if s.start < beat <= s.end and not s.is_air for f in SUPPORT_FEET[s.part]}
     if not named:
-        return [f for f in ("right", "left") if _planted_after(*events[f], beat)]
-    return [f for f in ("right", "left") if f in named and _planted_after(*events[f], beat)]
+        return [f for f in ("right", "left") if _planted_after(*events[f], beat, arriving)]
+    return [f for f in ("right", "left") if f in named and _planted_after(*events[f], beat, arriving)]
 
 
 class Support:
@@ -296,8 +304,14 @@ class Support:
                 self.pitch[foot][f1 + 1 :] = pb
                 xy[foot], level[foot] = target, s.level
             # Weight: the pelvis ends over the mean of the weight-bearing feet,
-            # as high as their legs (at their levels) allow.
-            feet = _weight_feet(sups, self.events, s.end)
+            # as high as their legs (at their levels) allow.  Where another
+            # support symbol starts at this one's end, the weight arrives on
+            # this symbol's feet and the next one moves it (DESIGN.md: a
+            # movement begins at its start), even if a gesture starting then
+            # is to free a foot; otherwise a gesture starting at the end needs
+            # its foot free already (the left leg of Wolofsky's Figure 7).
+            handed_on = any(x is not s and x.start == s.end and not x.is_air for x in sups)
+            feet = _weight_feet(sups, self.events, s.end, arriving=handed_on)
             if not feet:
                 log.info("no foot bears weight after beat %s; the pelvis holds", s.end)
                 continue

@@ -368,3 +368,58 @@ def test_random_scores_are_valid_and_reproducible():
     assert random_score(np.random.default_rng(1)) != random_score(np.random.default_rng(2))
     with pytest.raises(SyntheticError, match="Generator"):
         random_score(1)
+
+
+def test_weight_arrives_on_both_feet_before_the_next_support_moves_it():
+    # DESIGN.md: a movement begins at its start.  `support` ending at beat 2
+    # arrives on both feet; the transfer onto the left foot belongs to the
+    # `left_support` starting then, even though the right leg gestures from 2.
+    from capture2notation.compare.agreement import score_differences
+    from capture2notation.quantise.segment import segment_motion
+
+    score = Score(
+        (
+            Symbol(0, 1, "right_support", "place", "low"),
+            Symbol(1, 1, "left_leg", "left_forward", "middle", 1),
+            Symbol(2, 1, "support", "place", "middle"),
+            Symbol(3, 1, "left_support", "place", "low"),
+            Symbol(3, 1, "right_leg", "right", "low"),
+        ),
+        tempo=80,
+    )
+    fps = 25.0
+    _, J = assert_round_trip(score, fps)
+    f = round(3 * 60 / score.tempo * fps)
+    pelvis, right, left = J[f, _j("pelvis"), 0], J[f, _j("right_ankle"), 0], J[f, _j("left_ankle"), 0]
+    # Midway between the feet (the quantiser's "over a foot" is within a quarter of the way).
+    assert (pelvis - right) / (left - right) == pytest.approx(0.5, abs=0.05)
+    seg = segment_motion(J, fps, tempo=score.tempo)
+    assert score_differences(score, seg.score) == []
+
+
+@pytest.mark.parametrize("seed", [20260002, 20260010, 20260016])
+def test_random_supports_hand_the_weight_on_at_their_end(seed):
+    # At a beat where one support symbol ends and the next starts, the pelvis
+    # is over the mean of the feet the ending symbol names (those not
+    # gesturing since its start): the next symbol moves it only from there.
+    score = random_score(np.random.default_rng(seed), n_beats=8, turns=True, springs=True, travel=True, axes="body")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        J = interpret(score, 25.0).joints()
+    sups = [s for s in score.symbols if s.is_support and not s.is_air]
+    airs = [s for s in score.symbols if s.is_air]
+    feet = {"support": ("right", "left"), "right_support": ("right",), "left_support": ("left",)}
+    checked = 0
+    for s in sups:
+        if not any(x.start == s.end for x in sups) or any(a.end == s.start for a in airs):
+            continue  # not handed on, or a landing (its own pelvis path)
+        named = [
+            f
+            for f in feet[s.part]
+            if not any(g.part == f"{f}_leg" and s.start <= g.start < s.end for g in score.symbols)
+        ]
+        f = round(float(s.end * 60 / score.tempo) * 25.0)
+        mean = np.mean([J[f, _j(f"{n}_ankle"), :2] for n in named], axis=0)
+        assert np.linalg.norm(J[f, _j("pelvis"), :2] - mean) < 0.01, (s, named)
+        checked += 1
+    assert checked >= 1
