@@ -18,7 +18,15 @@ from ..errors import CalibrationError
 from ..io.calibration import Board
 from ..io.video import iter_frames, probe
 
-__all__ = ["MIN_CORNERS", "BoardDetections", "cv_board", "detect_clip", "detect_image", "detect_images", "object_points"]
+__all__ = [
+    "MIN_CORNERS",
+    "BoardDetections",
+    "cv_board",
+    "detect_clip",
+    "detect_image",
+    "detect_images",
+    "object_points",
+]
 
 #: Fewest ChArUco corners a view must have to be used: a homography needs 4,
 #: and fewer than 6 corners of a 24-corner board leave its pose ill-conditioned.

@@ -1,8 +1,8 @@
 """Bundle adjustment of cameras and board poses (scipy least squares, sparse Jacobian).
 
-Unknowns: per camera its intrinsics ``(fx, fy, cx, cy, k1, k2, p1, p2)``
-(OpenCV's model, k3 held at zero: a phone's or the renderer's lens needs no
-sixth-order term, and freeing it trades against k2) and its pose relative to
+Unknowns: per camera its intrinsics ``(fx, fy, cx, cy, k1, k2)`` (OpenCV's
+model; k3, p1, p2 held at zero: a phone's lens needs no sixth-order or
+tangential term, and freed they trade against k2 and the principal point) and its pose relative to
 the reference camera (Rodrigues vector, translation; the reference camera's
 pose is the identity, which fixes the gauge); per board view its pose in the
 reference camera's frame.  Residuals are pixel offsets of every detected
@@ -17,10 +17,15 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
-__all__ = ["N_INTRINSICS", "BundleResult", "Observations", "bundle_adjust", "project", "rodrigues"]
+__all__ = ["FREE_INTRINSICS", "N_INTRINSICS", "BundleResult", "Observations", "bundle_adjust", "project", "rodrigues"]
 
 #: Intrinsic parameters per camera: fx, fy, cx, cy, k1, k2, p1, p2.
 N_INTRINSICS = 8
+#: Intrinsics the bundle adjusts (fx, fy, cx, cy, k1, k2); the tangential
+#: terms p1, p2 stay zero: a phone's lens has practically none, and freed
+#: they trade against the principal point (rendered clips: principal point
+#: 4-7 px and camera centres 1-2 cm off with them free).
+FREE_INTRINSICS = (0, 1, 2, 3, 4, 5)
 #: Soft-L1 scale, pixels: residuals beyond it count linearly (a corner
 #: detector's error is a few tenths of a pixel; a wrong corner is pixels off).
 LOSS_SCALE_PX = 1.0
@@ -98,16 +103,20 @@ class BundleResult:
     residuals: np.ndarray
 
 
-def _unpack(x: np.ndarray, n_cam: int, n_view: int):
-    ni = n_cam * N_INTRINSICS
-    intr = x[:ni].reshape(n_cam, N_INTRINSICS)
+_NF = len(FREE_INTRINSICS)
+
+
+def _unpack(x: np.ndarray, n_cam: int, n_view: int, fixed: np.ndarray):
+    ni = n_cam * _NF
+    intr = fixed.copy()
+    intr[:, FREE_INTRINSICS] = x[:ni].reshape(n_cam, _NF)
     ext = np.concatenate([np.zeros((1, 6)), x[ni : ni + 6 * (n_cam - 1)].reshape(n_cam - 1, 6)])
     views = x[ni + 6 * (n_cam - 1) :].reshape(n_view, 6)
     return intr, ext, views
 
 
-def _residuals(x, obs: Observations, n_cam: int, n_view: int) -> np.ndarray:
-    intr, ext, views = _unpack(x, n_cam, n_view)
+def _residuals(x, obs: Observations, n_cam: int, n_view: int, fixed: np.ndarray) -> np.ndarray:
+    intr, ext, views = _unpack(x, n_cam, n_view, fixed)
     Rb = rodrigues(views[:, :3])[obs.view]
     p_ref = np.einsum("mij,mj->mi", Rb, obs.points) + views[obs.view, 3:]
     Rc = rodrigues(ext[:, :3])[obs.camera]
@@ -117,14 +126,14 @@ def _residuals(x, obs: Observations, n_cam: int, n_view: int) -> np.ndarray:
 
 def _sparsity(obs: Observations, n_cam: int, n_view: int):
     m = len(obs.camera)
-    ni = n_cam * N_INTRINSICS
+    ni = n_cam * _NF
     n = ni + 6 * (n_cam - 1) + 6 * n_view
     A = lil_matrix((2 * m, n), dtype=np.int8)
     rows = np.arange(m)
     for k in range(2):
         r = 2 * rows + k
-        for j in range(N_INTRINSICS):
-            A[r, obs.camera * N_INTRINSICS + j] = 1
+        for j in range(_NF):
+            A[r, obs.camera * _NF + j] = 1
         moving = obs.camera > 0
         for j in range(6):
             A[r[moving], ni + 6 * (obs.camera[moving] - 1) + j] = 1
@@ -153,9 +162,11 @@ def bundle_adjust(
         Starting board → reference poses.
     """
     n_cam, n_view = len(intrinsics), len(board_rvecs)
+    fixed = np.array(intrinsics, float)
+    fixed[:, [i for i in range(N_INTRINSICS) if i not in FREE_INTRINSICS]] = 0.0
     x0 = np.concatenate(
         [
-            np.asarray(intrinsics, float).ravel(),
+            fixed[:, FREE_INTRINSICS].ravel(),
             np.hstack([rvecs, tvecs])[1:].ravel(),
             np.hstack([board_rvecs, board_tvecs]).ravel(),
         ]
@@ -168,15 +179,15 @@ def bundle_adjust(
         f_scale=LOSS_SCALE_PX,
         x_scale="jac",
         method="trf",
-        args=(obs, n_cam, n_view),
+        args=(obs, n_cam, n_view, fixed),
         max_nfev=200,
     )
-    intr, ext, views = _unpack(sol.x, n_cam, n_view)
+    intr, ext, views = _unpack(sol.x, n_cam, n_view, fixed)
     return BundleResult(
         intr.copy(),
         rodrigues(ext[:, :3]),
         ext[:, 3:].copy(),
         rodrigues(views[:, :3]),
         views[:, 3:].copy(),
-        _residuals(sol.x, obs, n_cam, n_view).reshape(-1, 2),
+        _residuals(sol.x, obs, n_cam, n_view, fixed).reshape(-1, 2),
     )

@@ -29,16 +29,28 @@ from ..io.calibration import Board, Calibration, CameraCalibration
 from .board import BoardDetections, object_points
 from .bundle import N_INTRINSICS, Observations, bundle_adjust
 
-__all__ = ["MAX_INTRINSIC_VIEWS", "MAX_RMS_PX", "MAX_VIEWS", "CalibrationResult", "FLOOR_POSES", "calibrate_cameras", "floor_frame"]
+__all__ = [
+    "FLOOR_POSES",
+    "MAX_INTRINSIC_VIEWS",
+    "MAX_RMS_PX",
+    "MAX_VIEWS",
+    "CalibrationResult",
+    "calibrate_cameras",
+    "floor_frame",
+]
 
 #: Views per camera given to ``calibrateCamera`` for the starting intrinsics
 #: (spread over the clip; more add time, not accuracy, before the bundle).
 MAX_INTRINSIC_VIEWS = 40
 #: Board views (moments) in the bundle adjustment, spread over the clips.
-MAX_VIEWS = 240
+MAX_VIEWS = 120
 #: Fewest views a camera needs for its intrinsics (OpenCV needs 3 planar views
 #: of different tilts; one more to spare).
 MIN_VIEWS = 4
+#: Frames whose board pose is within this of the first shared view's (metres,
+#: degrees; a single view's pose scatters by millimetres and tenths of a
+#: degree) belong to the board still on the floor, fitted as one pose.
+STILL_M, STILL_DEG = 0.01, 1.0
 #: Largest acceptable reprojection RMS, pixels: a sound ChArUco calibration is
 #: well under one pixel; several pixels mean a wrong board, unsynchronised
 #: clips or a moving camera.
@@ -84,7 +96,7 @@ def _intrinsics(det: BoardDetections, obj: np.ndarray) -> np.ndarray:
     pick = _spread(good, MAX_INTRINSIC_VIEWS)
     objs = [obj[det.ids[k]].astype(np.float32) for k in pick]
     imgs = [det.corners[k].astype(np.float32) for k in pick]
-    flags = cv2.CALIB_FIX_K3
+    flags = cv2.CALIB_FIX_K3 | cv2.CALIB_ZERO_TANGENT_DIST
     try:
         _, K, dist, _, _ = cv2.calibrateCamera(objs, imgs, det.image_size, None, None, flags=flags)
     except cv2.error as exc:
@@ -130,6 +142,23 @@ def _relative(pose_c: dict, pose_p: dict, shared) -> tuple[np.ndarray, np.ndarra
 #: How the board stands at the clips' start to fix the world: upright on its
 #: lower edge (seen well by cameras at chest height) or lying face up.
 FLOOR_POSES = ("standing", "lying")
+
+
+def _still_start(shared_frames: list, poses: list, seen: dict) -> list:
+    """The first shared frame and the shared frames after it while the board stays still there."""
+    first = shared_frames[0]
+    c = seen[first][0]
+    R0, t0 = poses[c][first]
+    run = [first]
+    for f in shared_frames[1:]:
+        if c not in seen[f]:
+            break
+        R, t = poses[c][f]
+        angle = math.degrees(math.acos(np.clip((np.trace(R @ R0.T) - 1) / 2, -1.0, 1.0)))
+        if np.linalg.norm(t - t0) > STILL_M or angle > STILL_DEG:
+            break
+        run.append(f)
+    return run
 
 
 def floor_frame(
@@ -237,35 +266,37 @@ def calibrate_cameras(
         for f in pc:
             seen.setdefault(f, []).append(c)
     shared_frames = sorted(f for f, cs in seen.items() if len(cs) >= 2)
-    floor_view = shared_frames[0]
-    frames = np.array(sorted(seen))
-    keep = set(_spread(frames, MAX_VIEWS).tolist()) | set(_spread(np.array(shared_frames), MAX_VIEWS // 2).tolist())
-    keep.add(floor_view)
-    frames = np.array(sorted(keep))
-    b_rvec, b_tvec = np.zeros((len(frames), 3)), np.zeros((len(frames), 3))
+    still = _still_start(shared_frames, poses, seen)
+    rest = np.array([f for f in sorted(seen) if f not in still])
+    shared_rest = np.array([f for f in shared_frames if f not in still])
+    keep = set(_spread(rest, MAX_VIEWS).tolist()) | set(_spread(shared_rest, MAX_VIEWS // 2).tolist())
+    # View 0 is the board on the floor: every frame of its still start, one pose.
+    groups = [still] + [[f] for f in sorted(keep)]
+    b_rvec, b_tvec = np.zeros((len(groups), 3)), np.zeros((len(groups), 3))
     cams, views, pts, pix = [], [], [], []
-    for v, f in enumerate(frames):
-        cs = seen[int(f)]
-        c0 = max(cs, key=lambda c: len(detections[c].view(int(f))[0]))  # type: ignore[index]
-        Rb, tb = poses[c0][int(f)]
+    for v, group in enumerate(groups):
+        f0 = group[0]
+        cs = seen[f0]
+        c0 = max(cs, key=lambda c: len(detections[c].view(f0)[0]))  # type: ignore[index]
+        Rb, tb = poses[c0][f0]
         # board → ref = (ref → c0)⁻¹ ∘ (board → c0)
-        Rr = R_ext[c0].T @ Rb
-        b_rvec[v] = cv2.Rodrigues(Rr)[0].ravel()
+        b_rvec[v] = cv2.Rodrigues(R_ext[c0].T @ Rb)[0].ravel()
         b_tvec[v] = R_ext[c0].T @ (tb - t_ext[c0])
-        for c in cs:
-            got = detections[c].view(int(f))
-            assert got is not None
-            ids, px = got
-            cams.append(np.full(len(ids), c))
-            views.append(np.full(len(ids), v))
-            pts.append(obj[ids])
-            pix.append(px)
+        for f in group:
+            for c in seen[f]:
+                got = detections[c].view(f)
+                assert got is not None
+                ids, px = got
+                cams.append(np.full(len(ids), c))
+                views.append(np.full(len(ids), v))
+                pts.append(obj[ids])
+                pix.append(px)
     obs = Observations(np.concatenate(cams), np.concatenate(views), np.concatenate(pts), np.concatenate(pix))
     rvecs = np.array([cv2.Rodrigues(R_ext[c])[0].ravel() for c in range(n_cam)])
     tvecs = np.array([t_ext[c] for c in range(n_cam)])
     res = bundle_adjust(obs, intr, rvecs, tvecs, b_rvec, b_tvec)
     # World frame from the board on the floor.
-    v0 = int(np.searchsorted(frames, floor_view))
+    v0 = 0
     M, o = floor_frame(board, origin, floor, margin)
     Rb, tb = res.board_R[v0], res.board_t[v0]
     out, rms, nviews = [], {}, {}
@@ -277,9 +308,7 @@ def calibrate_cameras(
         tw = res.R[c] @ (tb - Rb @ M.T @ o) + res.t[c]
         U, _, Vt = np.linalg.svd(Rw)  # re-orthonormalise against rounding
         K, dist = _K_dist(res.intrinsics[c])
-        out.append(
-            CameraCalibration(name, detections[c].image_size, K, dist, U @ Vt, tw, rms_px=rms[name])
-        )
+        out.append(CameraCalibration(name, detections[c].image_size, K, dist, U @ Vt, tw, rms_px=rms[name]))
     for c, name in enumerate(names):
         if not rms[name] <= MAX_RMS_PX:
             raise CalibrationError(

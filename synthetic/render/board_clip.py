@@ -28,7 +28,7 @@ from .camera import Camera
 from .scene import floor_background
 from .video import open_writer
 
-__all__ = ["BOARD", "BoardPath", "board_path", "board_frame", "FLOOR_MARGIN", "floor_origin", "render_board_clip"]
+__all__ = ["BOARD", "FLOOR_MARGIN", "BoardPath", "board_frame", "board_path", "floor_origin", "render_board_clip"]
 
 #: The board the renderer moves: 7 × 5 squares of 12 cm (an 84 × 60 cm
 #: poster).  An A4 board's 4-cm squares are 7 px wide at the 3.8-m distance of
@@ -37,9 +37,9 @@ BOARD = Board((7, 5), 0.12, 0.09, "DICT_4X4_50")
 #: Seconds the board lies on the floor at the start.
 FLOOR_S = 1.0
 #: Seconds each pose is held, and taken to reach the next.
-HOLD_S, MOVE_S = 0.4, 0.4
+HOLD_S, MOVE_S = 0.3, 0.4
 #: Board poses after the floor.
-N_POSES = 16
+N_POSES = 12
 #: Largest angle, degrees, between the board's normal and the line to a
 #: camera: beyond it the markers are too foreshortened to read.
 MAX_INCIDENCE_DEG = 55.0
@@ -51,7 +51,7 @@ EDGE_MARGIN_PX = 12
 #: Space the board's centre moves in, metres (the performer's space).
 SPACE = ((-1.0, 1.0), (-1.0, 1.0), (0.5, 1.7))
 #: Largest tilt of the board away from facing the cameras, and in-plane turn, degrees.
-MAX_TILT_DEG, MAX_SPIN_DEG = 35.0, 30.0
+MAX_TILT_DEG, MAX_SPIN_DEG = 45.0, 30.0
 #: Supersampling factor of the warp.
 SUPERSAMPLE = 2
 #: Pixel noise, standard deviation in grey levels (a phone's sensor noise at
