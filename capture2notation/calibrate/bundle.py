@@ -180,7 +180,8 @@ def bundle_adjust(
         x_scale="jac",
         method="trf",
         args=(obs, n_cam, n_view, fixed),
-        max_nfev=200,
+        ftol=1e-7,
+        max_nfev=60,
     )
     intr, ext, views = _unpack(sol.x, n_cam, n_view, fixed)
     return BundleResult(

@@ -6,7 +6,8 @@ and area-averaged down, so its edges are anti-aliased like the dancer's),
 over the empty stage of :func:`.scene.floor_background`.  The board's path:
 standing upright on the floor at the origin, facing the cameras
 (:data:`FLOOR_S`: what fixes the calibrated world), then a sequence of random poses — tilted, near
-and far, each held :data:`HOLD_S` and reached in :data:`MOVE_S` — with
+and far, every other one seen by all cameras, the others near one camera's
+image edge, partly out of its frame — each held :data:`HOLD_S` and reached in :data:`MOVE_S` — with
 motion blur while it moves and pixel noise on every frame.
 """
 
@@ -39,7 +40,7 @@ FLOOR_S = 1.0
 #: Seconds each pose is held, and taken to reach the next.
 HOLD_S, MOVE_S = 0.3, 0.4
 #: Board poses after the floor.
-N_POSES = 12
+N_POSES = 16
 #: Largest angle, degrees, between the board's normal and the line to a
 #: camera: beyond it the markers are too foreshortened to read.
 MAX_INCIDENCE_DEG = 55.0
@@ -52,6 +53,10 @@ EDGE_MARGIN_PX = 12
 SPACE = ((-1.0, 1.0), (-1.0, 1.0), (0.5, 1.7))
 #: Largest tilt of the board away from facing the cameras, and in-plane turn, degrees.
 MAX_TILT_DEG, MAX_SPIN_DEG = 45.0, 30.0
+#: Distance range, metres, of the poses shown to one camera near its image edge.
+EDGE_DEPTH_M = (1.8, 4.0)
+#: Least fraction of the board's corners such a pose keeps in the image.
+MIN_SEEN_FRACTION = 0.6
 #: Supersampling factor of the warp.
 SUPERSAMPLE = 2
 #: Pixel noise, standard deviation in grey levels (a phone's sensor noise at
@@ -122,6 +127,36 @@ def _visible(R, p, board: Board, cameras: list[Camera], max_incidence: float = M
     return True
 
 
+def _facing(direction, rng: np.random.Generator) -> np.ndarray:
+    """Board → world rotation facing horizontal `direction`, then randomly tilted and turned."""
+    face = np.array([direction[0], direction[1], 0.0])
+    z = -face / np.linalg.norm(face)  # board z points into the board, away from the viewer
+    x = np.cross([0.0, 0.0, 1.0], z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)  # board y runs down the printed page
+    R = np.stack([x, y, z], axis=1)
+    spin = Rotation.from_rotvec(z * math.radians(rng.uniform(-MAX_SPIN_DEG, MAX_SPIN_DEG)))
+    axis = rng.normal(size=3)
+    axis -= (axis @ z) * z
+    tilt = Rotation.from_rotvec(axis / np.linalg.norm(axis) * math.radians(rng.uniform(0, MAX_TILT_DEG)))
+    return (tilt * spin).as_matrix() @ R
+
+
+def _partly_seen(R, p, board: Board, cam: Camera) -> bool:
+    """At least :data:`MIN_SEEN_FRACTION` of the inner corners inside `cam`'s image, face towards it."""
+    from capture2notation.calibrate import object_points
+
+    world = object_points(board) @ R.T + p
+    to_cam = cam.position - world.mean(axis=0)
+    if -R[:, 2] @ to_cam / np.linalg.norm(to_cam) < math.cos(math.radians(MAX_INCIDENCE_DEG)):
+        return False
+    uv = cam.project(world)
+    w, h = cam.size
+    m = EDGE_MARGIN_PX
+    inside = np.isfinite(uv).all(axis=1) & np.all((uv >= m) & (uv <= np.array([w - m, h - m])), axis=1)
+    return bool(inside.mean() >= MIN_SEEN_FRACTION)
+
+
 def board_path(cameras: list[Camera], rng: np.random.Generator, board: Board = BOARD) -> BoardPath:
     """A random path of the board that every camera sees at every keyframe.
 
@@ -141,20 +176,21 @@ def board_path(cameras: list[Camera], rng: np.random.Generator, board: Board = B
         tries += 1
         if tries > 20000:
             raise SyntheticError("found no board pose every camera sees; are the cameras round one space?")
+        if len(Rs) % 2 == 0:
+            # A pose near one camera's image edge, seen by it alone (ChArUco corners
+            # are read from a partial view): what pins its principal point and lens.
+            cam = cameras[int(rng.integers(len(cameras)))]
+            uv = rng.uniform([0, 0], cam.size)
+            ray = cam.R.T @ np.linalg.solve(cam.K, [uv[0], uv[1], 1.0])
+            c = cam.position + rng.uniform(*EDGE_DEPTH_M) * ray / np.linalg.norm(ray)
+            R = _facing(cam.position - c, rng)
+            p = c - R @ centre_b
+            if _partly_seen(R, p, board, cam) and np.all((_corners(board) @ R.T + p)[:, 2] > 0.05):
+                Rs.append(R)
+                ps.append(p)
+            continue
         c = np.array([rng.uniform(*SPACE[0]), rng.uniform(*SPACE[1]), rng.uniform(*SPACE[2])])
-        face = mean - c
-        face[2] = 0.0
-        face /= np.linalg.norm(face)
-        z = -face  # board z points into the board, away from the cameras
-        x = np.cross([0.0, 0.0, 1.0], z)
-        x /= np.linalg.norm(x)
-        y = np.cross(z, x)  # board y runs down the printed page
-        R = np.stack([x, y, z], axis=1)
-        spin = Rotation.from_rotvec(z * math.radians(rng.uniform(-MAX_SPIN_DEG, MAX_SPIN_DEG)))
-        axis = rng.normal(size=3)
-        axis -= (axis @ z) * z
-        tilt = Rotation.from_rotvec(axis / np.linalg.norm(axis) * math.radians(rng.uniform(0, MAX_TILT_DEG)))
-        R = (tilt * spin).as_matrix() @ R
+        R = _facing(mean - c, rng)
         p = c - R @ centre_b
         if _visible(R, p, board, cameras):
             Rs.append(R)

@@ -98,7 +98,7 @@ def test_a_fit_above_the_limit_is_refused(scene):
 
 
 def test_one_camera_or_repeated_names_are_refused(scene):
-    cams, (a, b) = scene
+    _cams, (a, b) = scene
     with pytest.raises(CalibrationError, match="two or more clips"):
         calibrate_cameras([a], ["front"], BOARD)
     with pytest.raises(CalibrationError, match="same camera name"):
