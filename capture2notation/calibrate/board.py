@@ -33,6 +33,15 @@ __all__ = [
 MIN_CORNERS = 6
 
 
+#: Half-size, pixels, of the window in which each ChArUco corner is refined
+#: again after OpenCV's detector (``cornerSubPix``): a 5 × 5 window keeps to
+#: the corner's own two squares when they are only 15-20 px wide, as a
+#: whole-body camera sees a poster board; on rendered boards it cut the
+#: corners' RMS error from 0.15-0.17 px to 0.10-0.11 px (wider windows: 0.15-0.20).
+REFINE_HALF_WINDOW_PX = 2
+_REFINE_CRITERIA = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 50, 1e-4)
+
+
 def cv_board(board: Board):
     """OpenCV's ``CharucoBoard`` for `board` (a one-line error for an unknown dictionary)."""
     name = board.dictionary
@@ -81,7 +90,11 @@ def detect_image(image: np.ndarray, board: Board, detector=None) -> tuple[np.nda
     corners, ids, _, _ = det.detectBoard(grey)
     if ids is None or len(ids) < MIN_CORNERS:
         return np.zeros(0, int), np.zeros((0, 2))
-    return np.asarray(ids, int).ravel(), np.asarray(corners, float).reshape(-1, 2)
+    w = REFINE_HALF_WINDOW_PX
+    refined = cv2.cornerSubPix(
+        grey, np.asarray(corners, np.float32).reshape(-1, 1, 2), (w, w), (-1, -1), _REFINE_CRITERIA
+    )
+    return np.asarray(ids, int).ravel(), np.asarray(refined, float).reshape(-1, 2)
 
 
 @dataclass(frozen=True)
