@@ -54,8 +54,8 @@ def test_rendered_clips_calibrate_to_rms_and_orientation_targets(calibrated):
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="centres 1.3-2.2 cm off (docs/benchmarks/calibration.md): the world's 0.2-0.3° tilt from one "
-    "standing board moves cameras 3.8 m away by that much",
+    reason="centres 1.3 cm off (docs/benchmarks/calibration.md): focal lengths 0.3 % long put the "
+    "cameras, 3.8 m away, that much too far from the board that fixes the world",
 )
 def test_rendered_clips_calibrate_to_the_centre_target(calibrated):
     truth, est = calibrated
