@@ -33,6 +33,7 @@ _COMMANDS: tuple[tuple[str, str], ...] = (
     ("score", "score"),
     ("fidelity", "fidelity_study"),
     ("capture", "capture"),
+    ("calibrate", "calibrate"),
 )
 
 #: Packages whose warnings are addressed to the user.

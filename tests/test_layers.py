@@ -1,7 +1,7 @@
 """The import graph: layers import one way only, and no module cycle.
 
 Layers, bottom to top (ARCHITECTURE.md): the base modules (``errors``,
-``atomic``, ``progress``) ← body ← notation ← io ← keypoints ← fitting ← quantise ← effort
+``atomic``, ``progress``) ← body ← notation ← io ← calibrate ← keypoints ← fitting ← quantise ← effort
 ← compare, then ``synthetic`` and ``pipelines`` beside each other above the
 library (pipelines may use synthetic for its demo and study; nothing in the
 library imports either).  Every import counts, including those inside
@@ -22,6 +22,7 @@ LAYERS = (
     "body",
     "notation",
     "io",
+    "calibrate",
     "keypoints",
     "fitting",
     "quantise",

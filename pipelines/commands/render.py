@@ -97,7 +97,37 @@ def _phone_camera(view, size, camera_height, pitch, roll, hfov):
 @click.option("--pitch", type=float, default=None, help="Camera pitch, degrees, positive looks up (-20..20).")
 @click.option("--roll", type=float, default=None, help="Camera roll about its axis, degrees (-10..10).")
 @click.option("--hfov", type=float, default=None, help="Horizontal field of view, degrees (50-80).")
-def render(score, outdir, fps, size, view, style, emotion, png, audio, camera_height, pitch, roll, hfov):
+@click.option(
+    "--views",
+    default=None,
+    help="Several cameras, e.g. front,45: OUTDIR/NAME/video.mp4 each, their true cameras in OUTDIR/cameras.toml.",
+)
+@click.option(
+    "--calibration-clip",
+    is_flag=True,
+    help="With --views: also a clip per camera of a ChArUco board moved through the space, OUTDIR/calibration/NAME.mp4.",
+)
+@click.option(
+    "--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True, help="Seed of the board's path."
+)
+def render(
+    score,
+    outdir,
+    fps,
+    size,
+    view,
+    style,
+    emotion,
+    png,
+    audio,
+    camera_height,
+    pitch,
+    roll,
+    hfov,
+    views,
+    calibration_clip,
+    seed,
+):
     """Perform the notation in SCORE (.lab, .json, 1974 coded input) with the
     virtual dancer and render it with its ground truth."""
     from capture2notation.notation import EMOTIONS
@@ -115,6 +145,11 @@ def render(score, outdir, fps, size, view, style, emotion, png, audio, camera_he
         raise PipelineError("--audio needs video.mp4: a folder of PNG frames (--png) has no sound track")
     if audio is not None and audio != "click" and not Path(audio).is_file():
         raise PipelineError(f"--audio {audio!r}: no such file; expected 'click' or a music file")
+    if views is not None:
+        _render_views(score, outdir, views, fps, wh, style, emotion, png, audio, calibration_clip, seed, view)
+        return
+    if calibration_clip:
+        raise PipelineError("--calibration-clip needs --views (two or more cameras to calibrate)")
     camera = _phone_camera(view, wh, camera_height, pitch, roll, hfov)
     parsed = read(score)
     video = "frames" if png else "video.mp4"
@@ -135,3 +170,40 @@ def render(score, outdir, fps, size, view, style, emotion, png, audio, camera_he
     click.echo(
         f"{out}: {video}, truth.npz, camera.toml and score.lab written ({style}, {view} view, {wh[0]}x{wh[1]} at {fps:g} fps{sound})"
     )
+
+
+def _render_views(score, outdir, views, fps, wh, style, emotion, png, audio, calibration_clip, seed, view):
+    from capture2notation.notation.formats import read
+    from synthetic.render import VIEWS
+    from synthetic.render.multiview import calibrate_command, render_views
+
+    names = [v.strip() for v in views.split(",") if v.strip()]
+    for v in names:
+        check_choice(v, "--views", list(VIEWS))
+    if len(names) < 2 or len(set(names)) != len(names):
+        raise PipelineError(f"--views {views!r} must name two or more different cameras, e.g. front,45")
+    ctx = click.get_current_context()
+    if ctx.get_parameter_source("view") != click.core.ParameterSource.DEFAULT:
+        raise PipelineError(f"--view {view!r} and --views {views!r}: give one of them")
+    fixed = ("camera_height", "pitch", "roll", "hfov")
+    if any(ctx.params.get(k) is not None for k in fixed) or png or audio is not None:
+        raise PipelineError(
+            "--views renders the preset cameras as mp4: drop --camera-height/--pitch/--roll/--hfov/--png/--audio"
+        )
+    out = render_views(
+        read(score),
+        outdir,
+        names,
+        fps=fps,
+        size=wh,
+        style=style,
+        emotion=emotion,
+        calibration_clip=calibration_clip,
+        seed=seed,
+    )
+    click.echo(
+        f"{out}: {', '.join(f'{v}/video.mp4' for v in names)}, cameras.toml and score.lab written ({style}, {wh[0]}x{wh[1]} at {fps:g} fps)"
+    )
+    if calibration_clip:
+        click.echo(f"{out}/calibration: a board clip per camera; calibrate them with")
+        click.echo("  " + calibrate_command(out, names))

@@ -143,3 +143,39 @@ def test_missing_or_malformed_score_names_the_file(tmp_path):
         res = CliRunner().invoke(main, ["render", str(path), "-o", str(tmp_path / "o")])
         assert res.exit_code == 2
         assert res.output.count("\n") == 1 and path.name in res.output
+
+
+def test_render_views_writes_every_camera(score_file, tmp_path):
+    from capture2notation.io.calibration import read_calibration
+
+    out = tmp_path / "mv"
+    r = CliRunner().invoke(main, ["render", str(score_file), "-o", str(out), "--views", "front,45", "--size", "64x48"])
+    assert r.exit_code == 0, r.output
+    cams = read_calibration(out / "cameras.toml")
+    assert cams.names == ("front", "45")
+    for name in cams.names:
+        truth = read_truth(out / name / "truth.npz")
+        assert truth.view == name
+        np.testing.assert_allclose(cams[name].R, truth.R, atol=1e-9)
+        assert _frames(out / name / "video.mp4")[0] == truth.n_frames
+    # the same performance from both cameras
+    a, b = read_truth(out / "front" / "truth.npz"), read_truth(out / "45" / "truth.npz")
+    np.testing.assert_array_equal(a.joints, b.joints)
+    assert not (out / "calibration").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["--views", "front"], "two or more"),
+        (["--views", "front,front"], "two or more"),
+        (["--views", "front,top"], "--views 'top'"),
+        (["--views", "front,45", "--view", "side"], "give one of them"),
+        (["--views", "front,45", "--pitch", "5"], "--pitch"),
+        (["--calibration-clip"], "--calibration-clip needs --views"),
+    ],
+)
+def test_render_views_bad_options_are_one_line_errors(score_file, tmp_path, args, expected):
+    r = CliRunner().invoke(main, ["render", str(score_file), "-o", str(tmp_path / "o"), "--size", "64x48", *args])
+    assert r.exit_code == 2
+    assert len(r.output.strip().splitlines()) == 1 and expected in r.output, r.output
