@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from capture2notation.errors import PipelineError
+from capture2notation.errors import C2NError, PipelineError
 
 from .capture import CaptureResult, _check_options, input_kind, notate
 
@@ -198,7 +198,8 @@ def capture_multi(
         ``keypoints_<camera>.npz``); ``files`` lists ``overlay_<camera>.mp4``.
     """
     from capture2notation.fitting.fit3d import fit_points3d
-    from capture2notation.fitting.triangulate import find_offset, landmarks_to_joints, triangulate
+    from capture2notation.fitting.motion import floor_height
+    from capture2notation.fitting.triangulate import find_offset, landmarks_to_joints, match_sides, triangulate
     from capture2notation.io.calibration import camera_name
 
     _check_options(backend, tempo, fps_override)
@@ -227,10 +228,21 @@ def capture_multi(
     vis = np.stack(
         [t.visibility[s] * np.clip(np.nan_to_num(t.presence[s]), 0, 1)[:, None] for t, s in zip(tracks, spans)]
     )
+    uv, vis, swapped = match_sides(uv, vis, cameras)
+    if swapped.any():
+        log.info("capture: left/right relabelled in %.0f %% of view-frames", 100 * swapped[1:].any(-1).mean())
     points, conf, _used = triangulate(uv, vis, cameras)
     joints, jconf, virtual = landmarks_to_joints(points, conf)
     if not np.any(jconf > 0):
         raise PipelineError(f"{videos[0]}: no joint was seen by two cameras at once (no person, or wrong calibration?)")
+    # DESIGN.md: the floor comes from where the feet rest, not from the
+    # calibration's zero (BlazePose's foot points sit above the sole).
+    try:
+        floor = floor_height(joints, jconf)
+    except C2NError as exc:
+        raise PipelineError(f"{videos[0]}: {exc}") from None
+    joints[..., 2] -= floor
+    virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
     seconds["triangulate"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     times = np.asarray(tracks[0].times)[spans[0]]

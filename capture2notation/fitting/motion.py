@@ -27,6 +27,7 @@ from .result import FitResult
 __all__ = [
     "MEASURED_FOR_LABELS",
     "MotionData",
+    "floor_height",
     "joints_for_labels",
     "motion_from_truth",
     "normalise_world",
@@ -183,6 +184,32 @@ def motion_from_truth(path) -> MotionData:
     )
 
 
+def floor_height(points: np.ndarray, confidence: np.ndarray) -> float:
+    """Height of the floor under measured joints, metres (see :func:`normalise_world`'s Notes).
+
+    Parameters
+    ----------
+    points : (T, J, 3) ndarray
+        Our joints, z up, metres (NaN where missing).
+    confidence : (T, J) ndarray
+
+    Raises
+    ------
+    MotionFileError
+        No ankle or toe is ever measured.
+    """
+    points = np.asarray(points, float)
+    ok = (np.asarray(confidence, float) > 0) & np.all(np.isfinite(points), axis=-1)
+    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
+    rest = Body().rest
+    fz = np.where(ok[:, feet], points[:, feet, 2] - rest[feet, 2], np.nan)
+    if not np.any(np.isfinite(fz)):
+        raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
+    return float(
+        np.nanpercentile(np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2)
+    )
+
+
 def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
     """Floor at z = 0, start at the origin, initially facing +y.
 
@@ -209,14 +236,7 @@ def normalise_world(points: np.ndarray, confidence: np.ndarray, extra=()):
     points = np.asarray(points, float)
     conf = np.asarray(confidence, float)
     ok = (conf > 0) & np.all(np.isfinite(points), axis=-1)
-    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
-    rest = Body().rest
-    fz = np.where(ok[:, feet], points[:, feet, 2] - rest[feet, 2], np.nan)
-    if not np.any(np.isfinite(fz)):
-        raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
-    floor = np.nanpercentile(
-        np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2
-    )
+    floor = floor_height(points, conf)
     right = None
     for a, b in (("right_hip", "left_hip"), ("right_shoulder", "left_shoulder")):
         ia, ib = joint_index(a), joint_index(b)

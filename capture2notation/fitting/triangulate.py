@@ -16,6 +16,7 @@ tree (and the model's virtual points) for :func:`~.fit3d.fit_points3d`.
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import median_filter
 
 from ..body import JOINTS, joint_index
 from ..body.skeleton import BLAZEPOSE_TO_JOINT
@@ -25,8 +26,10 @@ __all__ = [
     "MIN_VISIBILITY",
     "OUTLIER_PX",
     "RESIDUAL_PX",
+    "SIDE_GROUPS",
     "find_offset",
     "landmarks_to_joints",
+    "match_sides",
     "triangulate",
 ]
 
@@ -146,6 +149,76 @@ def _reprojection(X: np.ndarray, uv: np.ndarray, cameras, used: np.ndarray) -> n
         # An untriangulated point counts as far off, without overflowing its square.
         err[v] = np.where(used[v], np.nan_to_num(e, nan=1e6, posinf=1e6), 0.0)
     return err
+
+
+#: Left/right BlazePose landmark pairs that a keypoint model confuses together
+#: (a side view often labels the whole near leg as the far one).
+SIDE_GROUPS: dict[str, tuple[tuple[int, int], ...]] = {
+    "arms": ((11, 12), (13, 14), (15, 16), (17, 18), (19, 20), (21, 22)),
+    "legs": ((23, 24), (25, 26), (27, 28), (29, 30), (31, 32)),
+}
+
+
+#: Frames of the running median over which a view's left/right choice is made
+#: (0.2 s at 25 fps: legs crossing make single frames ambiguous).
+SIDE_MEDIAN_FRAMES = 5
+
+
+def _group_error(uv, vis, cameras) -> np.ndarray:
+    """Mean reprojection error (T,) of points triangulated from `uv` (V, T, n, 2); large where none."""
+    P, _, used = triangulate(uv, vis, cameras)
+    err = np.zeros(P.shape[:2])
+    n = np.zeros(P.shape[:2])
+    for v, cam in enumerate(cameras):
+        e = np.linalg.norm(cam.project(P) - uv[v], axis=-1)
+        ok = used[v] & np.isfinite(e)
+        err += np.where(ok, e, 0.0)
+        n += ok
+    return np.where(n.sum(axis=1) > 0, err.sum(axis=1) / np.maximum(n.sum(axis=1), 1), 1e6)
+
+
+def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Relabel left and right in each view to agree with the first view, per frame and limb group.
+
+    A keypoint model seeing a dancer from the side often swaps the legs
+    (or arms) as a whole; triangulating a swapped view against a right one
+    puts both limbs between them.  For each view after the first, each
+    group of :data:`SIDE_GROUPS` and each frame, the labelling whose
+    two-view triangulation with the first view reprojects closer is kept.
+
+    Parameters
+    ----------
+    uv : (V, T, 33, 2) ndarray
+    visibility : (V, T, 33) ndarray
+    cameras : sequence of V CameraCalibration
+
+    Returns
+    -------
+    uv, visibility : relabelled copies
+    swapped : (V, T, G) ndarray of bool
+        Where a view's group was relabelled (the first view never is).
+    """
+    uv = np.array(uv, float)
+    vis = np.array(visibility, float)
+    V, T = uv.shape[:2]
+    swapped = np.zeros((V, T, len(SIDE_GROUPS)), bool)
+    for v in range(1, V):
+        pair = [cameras[0], cameras[v]]
+        for g, pairs in enumerate(SIDE_GROUPS.values()):
+            idx = np.array([i for ab in pairs for i in ab])
+            alt = np.array([i for a, b in pairs for i in (b, a)])
+            keep = _group_error(
+                np.stack([uv[0][:, idx], uv[v][:, idx]]), np.stack([vis[0][:, idx], vis[v][:, idx]]), pair
+            )
+            swap = _group_error(
+                np.stack([uv[0][:, idx], uv[v][:, alt]]), np.stack([vis[0][:, idx], vis[v][:, alt]]), pair
+            )
+            # A running median over a few frames: a limb's label does not flicker.
+            frames = median_filter(swap - keep, size=SIDE_MEDIAN_FRAMES, mode="nearest") < 0
+            uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
+            vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
+            swapped[v, :, g] = frames
+    return uv, vis, swapped
 
 
 def landmarks_to_joints(points, confidence) -> tuple[np.ndarray, np.ndarray, dict]:
