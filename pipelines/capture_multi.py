@@ -133,6 +133,57 @@ def _align(tracks, offsets_s, videos, fps: float):
     return [slice(start - s, stop - s) for s in shifts]
 
 
+#: Weight of a joint taken from one view's monocular fit where the other
+#: views do not see it: depth from one view is the weak direction, so the
+#: fit's priors and the triangulated neighbours count for more.
+MONO_WEIGHT = 0.3
+
+
+def _monocular_fill(joints, jconf, tracks, spans, videos, calibration):
+    """Joints no two views saw, from the monocular fit of the view that sees them best.
+
+    Returns
+    -------
+    joints : (T, J, 3) ndarray
+    jconf : (T, J) ndarray
+        :data:`MONO_WEIGHT` × the monocular fit's confidence where filled.
+    """
+    from dataclasses import replace
+
+    from capture2notation.body import JOINTS
+    from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
+    from capture2notation.fitting import Camera, fit_track
+    from capture2notation.io.calibration import read_calibration
+
+    missing = jconf == 0
+    seen = []
+    for t, s in zip(tracks, spans):
+        vis = np.zeros(missing.shape)
+        for j, name in enumerate(JOINTS):
+            if name in JOINT_TO_BLAZEPOSE:
+                vis[:, j] = np.nan_to_num(t.visibility[s, JOINT_TO_BLAZEPOSE[name]])
+        seen.append(float(np.sum(np.where(missing, vis, 0.0))))
+    best = int(np.argmax(seen))
+    track, span = tracks[best], spans[best]
+    cut = replace(
+        track,
+        times=track.times[span],
+        xy=track.xy[span],
+        visibility=track.visibility[span],
+        presence=track.presence[span],
+        world=track.world[span],
+        crops=track.crops[span],
+        identity_confidence=np.asarray(track.identity_confidence)[span],
+    )
+    camera = Camera.from_calibration(read_calibration(calibration), videos[best], track.image_size)
+    mono = fit_track(cut, camera=camera)
+    log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
+    fill = missing & np.all(np.isfinite(mono.joints), axis=-1)
+    joints = np.where(fill[..., None], mono.joints, joints)
+    jconf = np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
+    return joints, jconf
+
+
 def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int):
     from capture2notation.keypoints import extract
 
@@ -235,6 +286,11 @@ def capture_multi(
     joints, jconf, virtual = landmarks_to_joints(points, conf)
     if not np.any(jconf > 0):
         raise PipelineError(f"{videos[0]}: no joint was seen by two cameras at once (no person, or wrong calibration?)")
+    missing = jconf == 0
+    if missing.any():
+        t1 = time.perf_counter()
+        joints, jconf = _monocular_fill(joints, jconf, tracks, spans, videos, calibration)
+        seconds["monocular"] = time.perf_counter() - t1
     # DESIGN.md: the floor comes from where the feet rest, not from the
     # calibration's zero (BlazePose's foot points sit above the sole).
     try:
