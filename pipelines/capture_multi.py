@@ -139,7 +139,7 @@ def _align(tracks, offsets_s, videos, fps: float):
 MONO_WEIGHT = 0.3
 
 
-def _monocular_fill(joints, jconf, tracks, spans, videos, calibration):
+def _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor: float = 0.0):
     """Joints no two views saw, from the monocular fit of the view that sees them best.
 
     Returns
@@ -147,6 +147,9 @@ def _monocular_fill(joints, jconf, tracks, spans, videos, calibration):
     joints : (T, J, 3) ndarray
     jconf : (T, J) ndarray
         :data:`MONO_WEIGHT` × the monocular fit's confidence where filled.
+
+    `floor` is the height subtracted from the triangulated joints, metres
+    (the monocular fit is in the calibration's world, so it is shifted alike).
     """
     from dataclasses import replace
 
@@ -179,7 +182,7 @@ def _monocular_fill(joints, jconf, tracks, spans, videos, calibration):
     mono = fit_track(cut, camera=camera)
     log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
     fill = missing & np.all(np.isfinite(mono.joints), axis=-1)
-    joints = np.where(fill[..., None], mono.joints, joints)
+    joints = np.where(fill[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
     jconf = np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
     return joints, jconf
 
@@ -286,12 +289,8 @@ def capture_multi(
     joints, jconf, virtual = landmarks_to_joints(points, conf)
     if not np.any(jconf > 0):
         raise PipelineError(f"{videos[0]}: no joint was seen by two cameras at once (no person, or wrong calibration?)")
-    missing = jconf == 0
-    if missing.any():
-        t1 = time.perf_counter()
-        joints, jconf = _monocular_fill(joints, jconf, tracks, spans, videos, calibration)
-        seconds["monocular"] = time.perf_counter() - t1
-    # DESIGN.md: the floor comes from where the feet rest, not from the
+    # DESIGN.md: the floor comes from where the triangulated feet rest (a
+    # monocular fill is too loose in depth to set it), not from the
     # calibration's zero (BlazePose's foot points sit above the sole).
     try:
         floor = floor_height(joints, jconf)
@@ -299,6 +298,11 @@ def capture_multi(
         raise PipelineError(f"{videos[0]}: {exc}") from None
     joints[..., 2] -= floor
     virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
+    missing = jconf == 0
+    if missing.any():
+        t1 = time.perf_counter()
+        joints, jconf = _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor)
+        seconds["monocular"] = time.perf_counter() - t1
     seconds["triangulate"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     times = np.asarray(tracks[0].times)[spans[0]]
