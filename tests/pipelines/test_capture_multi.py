@@ -138,9 +138,16 @@ def test_two_view_blazepose_capture_of_a_phrase_agrees_with_its_score(tmp_path):
         [root / v / "video.mp4" for v in VIEWS], tmp_path / "out", tempo=score.tempo,
         calibration=root / "cameras.toml", progress=False, effort=False, overlay=False,
     )  # fmt: skip
-    # One view reaches 80 % front and 54 % side on whole phrases (issue 15); two views measured 87.5 % here.
-    assert compare_scores(score, res.score).symbol_agreement >= 0.85
-    err = np.linalg.norm(
-        np.asarray(res.motion.joints) - np.asarray(read_truth(root / "front" / "truth.npz").joints), axis=-1
-    )
-    assert float(np.nanmean(err)) < 0.05
+    # Issue 15: one view reaches at best 80 % (front) on whole phrases; a second camera must beat that.
+    assert compare_scores(score, res.score).symbol_agreement > 0.80
+    # And its joints must be nearer the truth than the front camera's alone (calibrated likewise).
+    one = capture(
+        root / "front" / "video.mp4", tmp_path / "one", tempo=score.tempo, calibration=root / "cameras.toml",
+        progress=False, effort=False, overlay=False,
+    )  # fmt: skip
+    truth = np.asarray(read_truth(root / "front" / "truth.npz").joints)
+
+    def mpjpe(m):
+        return float(np.nanmean(np.linalg.norm(np.asarray(m.motion.joints) - truth, axis=-1)))
+
+    assert mpjpe(res) < mpjpe(one)
