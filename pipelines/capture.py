@@ -311,11 +311,19 @@ def capture(
         else:
             if calibration is None:
                 raise PipelineError(f"{input_path[0]}: several clips need --calibration FILE with every clip's camera")
-            from .capture_multi import capture_multi
+            from .capture_multi import load_views
 
-            return capture_multi(
-                input_path, outdir, calibration, backend, tempo, fps_override, progress, offsets=offsets,
-                meter=meter, params=params, effort=effort, seed=seed, overlay=overlay, flip_test=flip_test, axes=axes,
+            _check_options(backend, tempo, fps_override)
+            for v in input_path:
+                input_kind(v)  # a missing file or an unknown type, named
+            motion, seconds, per_view, source = load_views(
+                input_path, calibration, backend, fps_override, progress, offsets=offsets, overlay=overlay,
+                flip_test=flip_test,
+            )  # fmt: skip
+            return notate(
+                motion, None, seconds, input_path=Path(input_path[0]), outdir=outdir, kind="multiview", tempo=tempo,
+                meter=meter, params=params, effort=effort, seed=seed, overlay=overlay, axes=axes,
+                camera=(None, source), extra_outputs=per_view,
             )  # fmt: skip
     elif offsets is not None:
         raise PipelineError("--offsets is for several clips (one per camera)")

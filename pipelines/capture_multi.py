@@ -7,8 +7,9 @@ clips aligned in time (the calibration's ``offset_s``, ``--offsets`` or
 (:mod:`capture2notation.fitting.triangulate`), the 3D fit of motion files
 (:func:`~capture2notation.fitting.fit3d.fit_points3d`: bone lengths, joint
 limits, smoothness), then the one-view capture's quantiser, Effort and
-outputs (:func:`pipelines.capture.notate`), with ``overlay_<camera>.mp4``
-per camera.  The world frame is the calibration's (floor z = 0, z up).
+outputs (:func:`pipelines.capture.notate`, called by
+:func:`pipelines.capture.capture` with a list of clips), with
+``overlay_<camera>.mp4`` per camera.  The world frame is the calibration's (floor z = 0, z up).
 """
 
 from __future__ import annotations
@@ -22,15 +23,15 @@ import numpy as np
 
 from capture2notation.errors import C2NError, PipelineError
 
-from .capture import CaptureResult, _check_options, input_kind, notate
-
-__all__ = ["MAX_AUTO_LAG_S", "capture_multi", "check_views", "parse_offsets"]
+__all__ = ["MAX_AUTO_LAG_S", "check_views", "load_views", "parse_offsets"]
 
 log = logging.getLogger(__name__)
 
 #: Largest start offset between clips searched by ``--offsets auto``, seconds
 #: (two phones started by hand within a couple of seconds of each other).
 MAX_AUTO_LAG_S = 2.0
+#: Inputs that are motion files, not clips (``pipelines.capture.MOTION_SUFFIXES``).
+_MOTION_SUFFIXES = (".bvh", ".csv", ".npz")
 #: Largest difference between two clips' frame rates taken as equal, fps
 #: (containers round 25 to 25.0000x).
 _FPS_TOL = 0.01
@@ -87,7 +88,7 @@ def check_views(videos, calibration, fps_override=None):
             raise PipelineError(f"{videos[i]}: camera {n!r} is given twice (also {videos[names.index(n)]})")
     cameras, infos = [], []
     for video, name in zip(videos, names):
-        if input_kind(video) != "video":
+        if Path(video).suffix.lower() in _MOTION_SUFFIXES:
             raise PipelineError(f"{video}: a multi-camera capture takes video clips, not motion files")
         try:
             cam = cal[name]
@@ -209,32 +210,24 @@ def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int)
         return list(pool.map(one, videos))
 
 
-def capture_multi(
+def load_views(
     videos,
-    outdir,
     calibration,
     backend: str = "blazepose",
-    tempo=None,
     fps_override=None,
     progress: bool = True,
     *,
     offsets=None,
     workers: int = 2,
-    meter: int = 4,
-    params=None,
-    effort: bool = True,
-    seed: int = 0,
     overlay: bool = True,
     flip_test: bool = False,
-    axes: str = "standard",
-) -> CaptureResult:
-    """Capture notation from clips of two or more calibrated cameras.
+):
+    """Joints of a performance seen by two or more calibrated cameras.
 
     Parameters
     ----------
     videos : sequence of str or Path
         One clip per camera, named by :func:`~capture2notation.io.calibration.camera_name`.
-    outdir : str or Path
     calibration : str or Path
         Calibration file holding every clip's camera.
     offsets : "auto", sequence of float or str, optional
@@ -243,20 +236,27 @@ def capture_multi(
         motion (relative to the first clip).
     workers : int
         Clips whose keypoints run at once (threads).
+    overlay : bool
+        Write ``overlay_<camera>.mp4`` per camera.
     Other parameters are :func:`pipelines.capture.capture`'s.
 
     Returns
     -------
-    CaptureResult
-        ``kind`` is ``"multiview"``; ``track`` None (the per-view tracks go to
-        ``keypoints_<camera>.npz``); ``files`` lists ``overlay_<camera>.mp4``.
+    motion : FitResult
+        In the calibration's world, the floor moved to z = 0.
+    seconds : dict
+        Time per stage.
+    per_view : callable
+        ``per_view(folder) -> dict`` writes ``keypoints_<camera>.npz`` (and
+        overlays) into `folder` (for :func:`pipelines.capture.notate`).
+    source : str
+        The cameras used, for the page.
     """
     from capture2notation.fitting.fit3d import fit_points3d
     from capture2notation.fitting.motion import floor_height
     from capture2notation.fitting.triangulate import find_offset, landmarks_to_joints, match_sides, triangulate
     from capture2notation.io.calibration import camera_name
 
-    _check_options(backend, tempo, fps_override)
     videos = [Path(v) for v in videos]
     offs = parse_offsets(offsets, len(videos))
     cameras, infos = check_views(videos, calibration, fps_override)
@@ -321,20 +321,4 @@ def capture_multi(
         return files
 
     source = f"calibration {calibration} ({', '.join(names)})"
-    return notate(
-        motion,
-        None,
-        seconds,
-        input_path=videos[0],
-        outdir=outdir,
-        kind="multiview",
-        tempo=tempo,
-        meter=meter,
-        params=params,
-        effort=effort,
-        seed=seed,
-        overlay=overlay,
-        axes=axes,
-        camera=(None, source),
-        extra_outputs=per_view,
-    )
+    return motion, seconds, per_view, source
