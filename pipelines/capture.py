@@ -72,6 +72,7 @@ __all__ = [
     "capture",
     "input_kind",
     "load_motion",
+    "notate",
     "tempo_note",
 ]
 
@@ -293,13 +294,16 @@ def capture(
     axes: str = "standard",
     calibration=None,
     floor: float | None = None,
+    offsets=None,
 ) -> CaptureResult:
-    """Capture notation from a video or motion file.
+    """Capture notation from a video or motion file, or from clips of several calibrated cameras.
 
     Parameters
     ----------
-    input_path : str or Path
-        Video file, image folder, ``.bvh``, Kinect ``.csv`` or truth ``.npz``.
+    input_path : str or Path, or list of them
+        Video file, image folder, ``.bvh``, Kinect ``.csv`` or truth ``.npz``;
+        a list of two or more clips of calibrated cameras is a multi-camera
+        capture (:func:`pipelines.capture_multi.capture_multi`).
     outdir : str or Path
         Created if missing; see the module docstring for its files.
     backend : {"blazepose", "markers"}
@@ -328,17 +332,42 @@ def capture(
     axes : {"standard", "body"}
         The score's key (DESIGN.md, "Cross of axes").
     calibration : str or Path, optional
-        Calibration file with the video's camera (see :func:`load_motion`).
+        Calibration file with the video's camera (see :func:`load_motion`),
+        or every clip's camera.
     floor : float, optional
         The floor's height, metres, where the user knows it better than the
         capture: in a motion file's own coordinates once read (z up), or in
         a video's world (the calibration's, whose floor is z = 0, or the
         fit's own).  Found from the feet by default.
+    offsets : "auto" or list of float, optional
+        Several clips: their start offsets, seconds (see :func:`~pipelines.capture_multi.capture_multi`).
 
     Returns
     -------
     CaptureResult
     """
+    if isinstance(input_path, (list, tuple)):
+        if len(input_path) == 1:
+            input_path = input_path[0]
+        else:
+            if calibration is None:
+                raise PipelineError(f"{input_path[0]}: several clips need --calibration FILE with every clip's camera")
+            from .capture_multi import load_views
+
+            _check_options(backend, tempo, fps_override)
+            for v in input_path:
+                input_kind(v)  # a missing file or an unknown type, named
+            motion, seconds, per_view, source = load_views(
+                input_path, calibration, backend, fps_override, progress, offsets=offsets, overlay=overlay,
+                flip_test=flip_test,
+            )  # fmt: skip
+            return notate(
+                motion, None, seconds, input_path=Path(input_path[0]), outdir=outdir, kind="multiview", tempo=tempo,
+                meter=meter, params=params, effort=effort, seed=seed, overlay=overlay, axes=axes,
+                camera=(None, source), extra_outputs=per_view,
+            )  # fmt: skip
+    elif offsets is not None:
+        raise PipelineError("--offsets is for several clips (one per camera)")
     _check_options(backend, tempo, fps_override)
     kind = input_kind(input_path)
     outdir = Path(outdir)
@@ -358,6 +387,63 @@ def capture(
         seconds["camera"] = time.perf_counter() - t0
         camera_source = "estimated" if calibration is None else f"calibration {calibration}"
         log.info("capture: %s", estimate.line() if estimate is not None else "camera not estimated (feet unseen)")
+    return notate(
+        motion,
+        track,
+        seconds,
+        input_path=input_path,
+        outdir=outdir,
+        kind=kind,
+        tempo=tempo,
+        meter=meter,
+        params=params,
+        effort=effort,
+        seed=seed,
+        overlay=overlay,
+        axes=axes,
+        camera=(estimate, camera_source),
+    )
+
+
+def notate(
+    motion,
+    track,
+    seconds: dict,
+    *,
+    input_path,
+    outdir,
+    kind: str,
+    tempo=None,
+    meter: int = 4,
+    params: SegmentParams | None = None,
+    effort: bool = True,
+    seed: int = 0,
+    overlay: bool = True,
+    axes: str = "standard",
+    camera=(None, ""),
+    extra_outputs=None,
+) -> CaptureResult:
+    """Quantise fitted joints and write every output of a capture (after :func:`load_motion`).
+
+    Parameters
+    ----------
+    motion : FitResult
+    track : KeypointTrack or None
+    seconds : dict
+        Stage timings so far (updated).
+    input_path : str or Path
+        The input named in the outputs; for video kinds, the clip whose sound gives the tempo.
+    kind : str
+        ``"video"``, ``"multiview"`` or a motion-file kind (:func:`input_kind`).
+    camera : (CameraEstimate or None, str)
+        The camera estimate and the camera the fit used.
+    extra_outputs : callable, optional
+        ``extra_outputs(stage) -> dict`` of further files written into the
+        staging folder (a multi-view capture's overlays).
+    Other parameters are :func:`capture`'s.
+    """
+    outdir = Path(outdir)
+    estimate, camera_source = camera
     # The body key is LabanotationSuite's reading of a Kinect's own arm
     # positions; the standard key keeps the fit throughout.
     measured_arms = kind != "video" and axes == "body"
@@ -367,7 +453,7 @@ def capture(
         raise PipelineError(f"{input_path}: no frame could be measured (no person found?)")
 
     evidence, sound = None, ""
-    if kind == "video" and tempo is None:
+    if kind in ("video", "multiview") and tempo is None:
         t0 = time.perf_counter()
         evidence, sound = _sound_evidence(input_path, fps)
         seconds["sound"] = time.perf_counter() - t0
@@ -412,6 +498,8 @@ def capture(
     log.info("capture: tempo %s bpm%s", seg.tempo, how)
     with _staging(outdir) as stage:
         files, skipped = _write_outputs(stage, seg, motion, track, input_path, kind, overlay, (estimate, camera_source))
+        if extra_outputs is not None:
+            files.update(extra_outputs(stage))
         if effort:
             t0 = time.perf_counter()
             try:
@@ -482,7 +570,7 @@ def _write_outputs(
         from capture2notation.keypoints.overlay import write_overlay
 
         files["overlay.mp4"] = write_overlay(input_path, track, outdir / "overlay.mp4", fps=track.fps)
-    elif kind != "video":
+    elif kind not in ("video", "multiview"):
         skipped.append("overlay.mp4: no video (motion file input)")
     return files, skipped
 

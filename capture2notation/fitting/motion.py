@@ -28,6 +28,7 @@ from .result import FitResult
 __all__ = [
     "MEASURED_FOR_LABELS",
     "MotionData",
+    "floor_height",
     "joints_for_labels",
     "motion_from_truth",
     "normalise_world",
@@ -189,6 +190,35 @@ def motion_from_truth(path) -> MotionData:
         confidence=conf.reshape(T, J),
         offsets=np.array(body.offsets),
         source="truth",
+    )
+
+
+def floor_height(points: np.ndarray, confidence: np.ndarray) -> float:
+    """Height of the floor under triangulated joints, metres: the 2nd percentile of each frame's lowest foot point.
+
+    The multi-camera capture's floor (measured there against a median; motion
+    files use the grounded fit of :func:`~.ground.fit_floor` instead).
+
+    Parameters
+    ----------
+    points : (T, J, 3) ndarray
+        Our joints, z up, metres (NaN where missing).
+    confidence : (T, J) ndarray
+
+    Raises
+    ------
+    MotionFileError
+        No ankle or toe is ever measured.
+    """
+    points = np.asarray(points, float)
+    ok = (np.asarray(confidence, float) > 0) & np.all(np.isfinite(points), axis=-1)
+    feet = [joint_index(n) for n in ("right_ankle", "left_ankle", "right_toe", "left_toe")]
+    rest = Body().rest
+    fz = np.where(ok[:, feet], points[:, feet, 2] - rest[feet, 2], np.nan)
+    if not np.any(np.isfinite(fz)):
+        raise MotionFileError("no foot (ankle or toe) is ever tracked: cannot find the floor")
+    return float(
+        np.nanpercentile(np.nanmin(np.where(np.isfinite(fz), fz, np.inf), axis=1)[np.any(np.isfinite(fz), axis=1)], 2)
     )
 
 

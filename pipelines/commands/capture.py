@@ -35,7 +35,7 @@ FLOOR = FloorOrAuto()
 
 
 @click.command("capture")
-@click.argument("input_path", metavar="INPUT", type=click.Path(exists=True, path_type=str))
+@click.argument("input_paths", metavar="INPUT...", nargs=-1, required=True, type=click.Path(exists=True, path_type=str))
 @click.option(
     "-o",
     "--output",
@@ -94,11 +94,31 @@ FLOOR = FloorOrAuto()
     "coordinates (z up, once read) or in a video's world (a calibration's floor is 0). "
     "Default 'auto': found from the feet (a motion file's tilt and drift too).",
 )
+@click.option(
+    "--offsets",
+    default=None,
+    metavar="S,S,...|auto",
+    help="Several clips: seconds each clip starts after the reference clock (one per clip), or 'auto' "
+    "to find them from the keypoint motion; default the calibration's offset_s.",
+)
 def capture(
-    input_path, outdir, backend, tempo, fps_override, grid, no_effort, seed, flip_test, axes, calibration, floor
+    input_paths,
+    outdir,
+    backend,
+    tempo,
+    fps_override,
+    grid,
+    no_effort,
+    seed,
+    flip_test,
+    axes,
+    calibration,
+    floor,
+    offsets,
 ):
     """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
-    into notation files in OUTDIR."""
+    into notation files in OUTDIR.  Several video clips of calibrated cameras
+    (--calibration naming each clip's camera) are triangulated into one capture."""
     from fractions import Fraction
 
     from capture2notation.errors import PipelineError
@@ -115,8 +135,10 @@ def capture(
         raise PipelineError(f"--grid {grid!r} must be a fraction of a beat in (0, 4]")
     check_outdir(outdir)
     tempo_value = tempo if tempo is None or tempo == NO_TEMPO else Fraction(tempo).limit_denominator(1000)
+    if offsets is not None and len(input_paths) < 2:
+        raise PipelineError("--offsets is for several clips (one per camera)")
     result = run(
-        input_path,
+        list(input_paths) if len(input_paths) > 1 else input_paths[0],
         outdir,
         backend=backend,
         tempo=tempo_value,
@@ -129,6 +151,7 @@ def capture(
         axes=axes,
         calibration=calibration,
         floor=floor,
+        **({"offsets": offsets} if offsets is not None else {}),
     )
     click.echo(
         f"{result.outdir}: {len(result.score.symbols)} symbols from {result.n_frames} frames "

@@ -1,0 +1,324 @@
+"""Capture from two or more calibrated cameras (issue 15, item 3).
+
+``c2n capture A.mp4 B.mp4 --calibration cameras.toml -o OUT``: keypoints per
+view (the views in parallel threads: onnxruntime releases the GIL), the
+clips aligned in time (the calibration's ``offset_s``, ``--offsets`` or
+``auto``: from the keypoint motion), a confidence-weighted triangulation
+(:mod:`capture2notation.fitting.triangulate`), the 3D fit of motion files
+(:func:`~capture2notation.fitting.fit3d.fit_points3d`: bone lengths, joint
+limits, smoothness), then the one-view capture's quantiser, Effort and
+outputs (:func:`pipelines.capture.notate`, called by
+:func:`pipelines.capture.capture` with a list of clips), with
+``overlay_<camera>.mp4`` per camera.  The world frame is the calibration's (floor z = 0, z up).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from capture2notation.errors import C2NError, PipelineError
+
+__all__ = ["MAX_AUTO_LAG_S", "check_views", "load_views", "parse_offsets"]
+
+log = logging.getLogger(__name__)
+
+#: Largest start offset between clips searched by ``--offsets auto``, seconds
+#: (two phones started by hand within a couple of seconds of each other).
+MAX_AUTO_LAG_S = 2.0
+#: Inputs that are motion files, not clips (``pipelines.capture.MOTION_SUFFIXES``).
+_MOTION_SUFFIXES = (".bvh", ".csv", ".npz")
+#: Largest difference between two clips' frame rates taken as equal, fps
+#: (containers round 25 to 25.0000x).
+_FPS_TOL = 0.01
+
+
+def parse_offsets(text, n: int) -> list[float] | str | None:
+    """``--offsets`` as seconds per clip, ``"auto"`` or None.
+
+    Raises
+    ------
+    PipelineError
+        Not ``auto`` nor `n` comma-separated numbers.
+    """
+    if text is None or (isinstance(text, str) and text.strip() == "auto"):
+        return None if text is None else "auto"
+    if isinstance(text, (list, tuple)):
+        parts = list(text)
+    else:
+        parts = [p for p in str(text).split(",") if p.strip()]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise PipelineError(f"--offsets {text!r} must be 'auto' or {n} seconds separated by commas") from None
+    if len(values) != n or not all(np.isfinite(values)) or any(abs(v) > 3600 for v in values):
+        raise PipelineError(f"--offsets {text!r} must be {n} seconds (one per clip, within an hour) or 'auto'")
+    return values
+
+
+def check_views(videos, calibration, fps_override=None):
+    """Probe the clips and match each to its calibrated camera, before any keypoints.
+
+    Returns
+    -------
+    cameras : list of CameraCalibration
+    infos : list of VideoInfo
+
+    Raises
+    ------
+    PipelineError
+        Fewer than two clips, two clips of one camera, a camera missing from
+        the calibration, other image sizes than the calibration's, frame
+        rates that differ; each names the file and the mismatch.
+    """
+    from capture2notation.errors import CalibrationError
+    from capture2notation.io.calibration import camera_name, read_calibration
+    from capture2notation.io.video import probe
+
+    if len(videos) < 2:
+        raise PipelineError("a multi-camera capture needs at least two clips")
+    cal = read_calibration(calibration)
+    names = [camera_name(v) for v in videos]
+    for i, n in enumerate(names):
+        if n in names[:i]:
+            raise PipelineError(f"{videos[i]}: camera {n!r} is given twice (also {videos[names.index(n)]})")
+    cameras, infos = [], []
+    for video, name in zip(videos, names):
+        if Path(video).suffix.lower() in _MOTION_SUFFIXES:
+            raise PipelineError(f"{video}: a multi-camera capture takes video clips, not motion files")
+        try:
+            cam = cal[name]
+        except CalibrationError as exc:
+            raise PipelineError(f"{video}: {exc} in {calibration}") from None
+        info = probe(video, fps_override)
+        if (info.width, info.height) != tuple(cam.image_size):
+            raise PipelineError(
+                f"{video}: frames are {info.width}x{info.height} but camera {name!r} in {calibration} is "
+                f"calibrated for {cam.image_size[0]}x{cam.image_size[1]}"
+            )
+        if infos and abs(info.fps - infos[0].fps) > _FPS_TOL:
+            raise PipelineError(
+                f"{video}: frame rate {info.fps:g} fps differs from {infos[0].path}'s {infos[0].fps:g} fps"
+            )
+        cameras.append(cam)
+        infos.append(info)
+    return cameras, infos
+
+
+class _Frames:
+    """A stand-in track of `n` frames (the declared length, before keypoints)."""
+
+    def __init__(self, n: int):
+        self.times = np.zeros(n)
+
+
+def _align(tracks, offsets_s, videos, fps: float):
+    """Frame ranges of each track covering the common time, from start offsets (s)."""
+    shifts = [int(round(o * fps)) for o in offsets_s]  # frames each clip starts late
+    lengths = [len(t.times) for t in tracks]
+    if not any(shifts) and len(set(lengths)) > 1:
+        i = int(np.argmin(lengths))
+        j = int(np.argmax(lengths))
+        raise PipelineError(
+            f"{videos[i]}: {lengths[i]} frames but {videos[j]} has {lengths[j]} "
+            "(clips of different lengths: give --offsets or --offsets auto)"
+        )
+    start = max(shifts)  # on the reference clock
+    stop = min(s + n for s, n in zip(shifts, lengths))
+    if stop - start < 2:
+        raise PipelineError(f"{videos[0]}: the clips do not overlap in time (offsets {offsets_s} s)")
+    return [slice(start - s, stop - s) for s in shifts]
+
+
+#: Weight of a joint taken from one view's monocular fit where the other
+#: views do not see it: depth from one view is the weak direction, so the
+#: fit's priors and the triangulated neighbours count for more.
+MONO_WEIGHT = 0.3
+
+
+def _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor: float = 0.0):
+    """Joints no two views saw, from the monocular fit of the view that sees them best.
+
+    Returns
+    -------
+    joints : (T, J, 3) ndarray
+    jconf : (T, J) ndarray
+        :data:`MONO_WEIGHT` × the monocular fit's confidence where filled.
+
+    `floor` is the height subtracted from the triangulated joints, metres
+    (the monocular fit is in the calibration's world, so it is shifted alike).
+    """
+    from dataclasses import replace
+
+    from capture2notation.body import JOINTS
+    from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
+    from capture2notation.fitting import Camera, fit_track
+    from capture2notation.io.calibration import read_calibration
+
+    missing = jconf == 0
+    seen = []
+    for t, s in zip(tracks, spans):
+        vis = np.zeros(missing.shape)
+        for j, name in enumerate(JOINTS):
+            if name in JOINT_TO_BLAZEPOSE:
+                vis[:, j] = np.nan_to_num(t.visibility[s, JOINT_TO_BLAZEPOSE[name]])
+        seen.append(float(np.sum(np.where(missing, vis, 0.0))))
+    best = int(np.argmax(seen))
+    track, span = tracks[best], spans[best]
+    cut = replace(
+        track,
+        times=track.times[span],
+        xy=track.xy[span],
+        visibility=track.visibility[span],
+        presence=track.presence[span],
+        world=track.world[span],
+        crops=track.crops[span],
+        identity_confidence=np.asarray(track.identity_confidence)[span],
+    )
+    camera = Camera.from_calibration(read_calibration(calibration), videos[best], track.image_size)
+    mono = fit_track(cut, camera=camera)
+    log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
+    fill = missing & np.all(np.isfinite(mono.joints), axis=-1)
+    joints = np.where(fill[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
+    jconf = np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
+    return joints, jconf
+
+
+def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int):
+    from capture2notation.keypoints import extract
+
+    # onnxruntime releases the GIL: a thread per view, one intra-op thread each.
+    threads = 1 if workers > 1 else 2
+
+    def one(v):
+        return extract(
+            v,
+            backend=backend,
+            fps=fps_override,
+            progress=progress and workers == 1,
+            flip_test=flip_test,
+            threads=threads,
+        )
+
+    if workers <= 1:
+        return [one(v) for v in videos]
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(one, videos))
+
+
+def load_views(
+    videos,
+    calibration,
+    backend: str = "blazepose",
+    fps_override=None,
+    progress: bool = True,
+    *,
+    offsets=None,
+    workers: int = 2,
+    overlay: bool = True,
+    flip_test: bool = False,
+):
+    """Joints of a performance seen by two or more calibrated cameras.
+
+    Parameters
+    ----------
+    videos : sequence of str or Path
+        One clip per camera, named by :func:`~capture2notation.io.calibration.camera_name`.
+    calibration : str or Path
+        Calibration file holding every clip's camera.
+    offsets : "auto", sequence of float or str, optional
+        Seconds each clip starts after the reference clock; default the
+        calibration's ``offset_s``; ``"auto"`` finds them from the keypoint
+        motion (relative to the first clip).
+    workers : int
+        Clips whose keypoints run at once (threads).
+    overlay : bool
+        Write ``overlay_<camera>.mp4`` per camera.
+    Other parameters are :func:`pipelines.capture.capture`'s.
+
+    Returns
+    -------
+    motion : FitResult
+        In the calibration's world, the floor moved to z = 0.
+    seconds : dict
+        Time per stage.
+    per_view : callable
+        ``per_view(folder) -> dict`` writes ``keypoints_<camera>.npz`` (and
+        overlays) into `folder` (for :func:`pipelines.capture.notate`).
+    source : str
+        The cameras used, for the page.
+    """
+    from capture2notation.fitting.fit3d import fit_points3d
+    from capture2notation.fitting.motion import floor_height
+    from capture2notation.fitting.triangulate import find_offset, landmarks_to_joints, match_sides, triangulate
+    from capture2notation.io.calibration import camera_name
+
+    videos = [Path(v) for v in videos]
+    offs = parse_offsets(offsets, len(videos))
+    cameras, infos = check_views(videos, calibration, fps_override)
+    counts = [i.frame_count for i in infos]
+    if offs is None and not any(c.offset_s for c in cameras) and all(counts) and len(set(counts)) > 1:
+        # Fail before the slow keypoints: same-clock clips must be equally long.
+        _align([_Frames(c) for c in counts], [0.0] * len(counts), videos, 1.0)
+    seconds: dict = {}
+    t0 = time.perf_counter()
+    tracks = _keypoints(videos, backend, fps_override, progress, flip_test, max(1, int(workers)))
+    seconds["keypoints"] = time.perf_counter() - t0
+    fps = float(tracks[0].fps)
+    if offs is None:
+        offs = [c.offset_s for c in cameras]
+    elif offs == "auto":
+        lag = int(round(MAX_AUTO_LAG_S * fps))
+        # find_offset: other[i] shows reference[i + lag], i.e. other starts lag frames late.
+        offs = [0.0] + [find_offset(tracks[0].xy[..., :2], t.xy[..., :2], lag) / fps for t in tracks[1:]]
+        log.info("capture: clip offsets from the motion: %s s", ", ".join(f"{o:+.2f}" for o in offs))
+    spans = _align(tracks, list(offs), videos, fps)
+    t0 = time.perf_counter()
+    uv = np.stack([t.xy[s, :, :2] for t, s in zip(tracks, spans)])
+    vis = np.stack(
+        [t.visibility[s] * np.clip(np.nan_to_num(t.presence[s]), 0, 1)[:, None] for t, s in zip(tracks, spans)]
+    )
+    uv, vis, swapped = match_sides(uv, vis, cameras)
+    if swapped.any():
+        log.info("capture: left/right relabelled in %.0f %% of view-frames", 100 * swapped[1:].any(-1).mean())
+    points, conf, _used = triangulate(uv, vis, cameras)
+    joints, jconf, virtual = landmarks_to_joints(points, conf)
+    if not np.any(jconf > 0):
+        raise PipelineError(f"{videos[0]}: no joint was seen by two cameras at once (no person, or wrong calibration?)")
+    # DESIGN.md: the floor comes from where the triangulated feet rest (a
+    # monocular fill is too loose in depth to set it), not from the
+    # calibration's zero (BlazePose's foot points sit above the sole).
+    try:
+        floor = floor_height(joints, jconf)
+    except C2NError as exc:
+        raise PipelineError(f"{videos[0]}: {exc}") from None
+    joints[..., 2] -= floor
+    virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
+    missing = jconf == 0
+    if missing.any():
+        t1 = time.perf_counter()
+        joints, jconf = _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor)
+        seconds["monocular"] = time.perf_counter() - t1
+    seconds["triangulate"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    times = np.asarray(tracks[0].times)[spans[0]]
+    motion = fit_points3d(joints, jconf, fps, times=times - times[0], virtual=virtual)
+    seconds["fitting"] = time.perf_counter() - t0
+    names = [camera_name(v) for v in videos]
+
+    def per_view(stage: Path) -> dict:
+        files = {}
+        for name, video, track in zip(names, videos, tracks):
+            files[f"keypoints_{name}.npz"] = track.save(stage / f"keypoints_{name}.npz")
+            if overlay:
+                from capture2notation.keypoints.overlay import write_overlay
+
+                files[f"overlay_{name}.mp4"] = write_overlay(video, track, stage / f"overlay_{name}.mp4", fps=track.fps)
+        return files
+
+    source = f"calibration {calibration} ({', '.join(names)})"
+    return motion, seconds, per_view, source

@@ -1,0 +1,153 @@
+"""Capture from two calibrated cameras: geometry, the fit, bad input, and the whole path."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import cv2
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from capture2notation.errors import PipelineError
+from capture2notation.fitting.fit3d import fit_points3d
+from capture2notation.fitting.triangulate import landmarks_to_joints, triangulate
+from capture2notation.io.calibration import Calibration, read_calibration, write_calibration
+from capture2notation.io.truth import read_truth
+from pipelines.capture import capture
+from pipelines.cli import main
+from synthetic import builtin_phrases
+from synthetic.render import render_score
+
+VIEWS = ("front", "side")
+#: DESIGN.md / issue 15's MPJPE target for calibrated cameras, metres.
+MPJPE_TARGET_M = 0.03
+
+
+def _render(root, size, style="markers"):
+    score = builtin_phrases()["figure7"]
+    cams = []
+    for v in VIEWS:
+        render_score(score, root / v, fps=25.0, size=size, view=v, style=style, progress=False)
+        (cam,) = read_calibration(root / v / "camera.toml").cameras.values()
+        cams.append(cam)
+    write_calibration(Calibration.of(cams), root / "cameras.toml")
+    return score, root
+
+
+@pytest.fixture(scope="module")
+def two_views(tmp_path_factory):
+    return _render(tmp_path_factory.mktemp("two_views"), (320, 240))
+
+
+def test_perfect_keypoints_of_two_views_fit_within_the_target(two_views):
+    """The renderer's own landmarks (exact pixels) seen by both cameras: triangulation + 3D fit."""
+    _, root = two_views
+    cal = read_calibration(root / "cameras.toml")
+    truths = [read_truth(root / v / "truth.npz") for v in VIEWS]
+    uv = np.stack([np.asarray(t.keypoints, float) for t in truths])
+    vis = np.ones(uv.shape[:3])
+    points, conf, _ = triangulate(uv, vis, [cal[v] for v in VIEWS])
+    joints, jconf, virtual = landmarks_to_joints(points, conf)
+    fit = fit_points3d(joints, jconf, truths[0].fps, virtual=virtual)
+    err = np.linalg.norm(np.asarray(fit.joints) - np.asarray(truths[0].joints), axis=-1)
+    assert float(np.nanmean(err)) < MPJPE_TARGET_M
+
+
+def test_two_view_marker_capture_writes_every_output(two_views, tmp_path):
+    _, root = two_views
+    res = capture(
+        [root / v / "video.mp4" for v in VIEWS], tmp_path / "out", backend="markers", tempo=60,
+        calibration=root / "cameras.toml", progress=False, effort=False,
+    )  # fmt: skip
+    assert res.kind == "multiview"
+    for v in VIEWS:
+        assert (tmp_path / "out" / f"overlay_{v}.mp4").is_file()
+        assert f"overlay_{v}.mp4" in res.files
+    page = (tmp_path / "out" / "index.html").read_text()
+    assert all(f'src="overlay_{v}.mp4"' in page for v in VIEWS)
+    assert res.n_frames == read_truth(root / "front" / "truth.npz").n_frames
+
+
+def _copy_frames(src, dst, fps=None, n=None):
+    """Re-encode `src` to `dst` at `fps` (default its own), keeping its first `n` frames."""
+    cap = cv2.VideoCapture(str(src))
+    rate = fps or cap.get(cv2.CAP_PROP_FPS)
+    w, h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+    os.makedirs(dst.parent, exist_ok=True)
+    out = cv2.VideoWriter(str(dst), cv2.VideoWriter_fourcc(*"mp4v"), rate, (w, h))
+    i = 0
+    while n is None or i < n:
+        ok, frame = cap.read()
+        if not ok:
+            break
+        out.write(frame)
+        i += 1
+    cap.release()
+    out.release()
+    return dst
+
+
+def _run(videos, cal, out):
+    return capture([str(v) for v in videos], out, backend="markers", tempo=60, calibration=cal,
+                   progress=False, effort=False)  # fmt: skip
+
+
+def test_bad_inputs_name_the_file_and_the_mismatch(two_views, tmp_path):
+    _, root = two_views
+    front, side, cal = root / "front" / "video.mp4", root / "side" / "video.mp4", root / "cameras.toml"
+    other = shutil.copy(side, tmp_path / "other.mp4")
+    with pytest.raises(PipelineError, match=r"other\.mp4.*no camera 'other'"):
+        _run([front, other], cal, tmp_path / "a")
+    big = Calibration.of([c.scaled_to((640, 480)) for c in read_calibration(cal).cameras.values()])
+    write_calibration(big, tmp_path / "big.toml")
+    with pytest.raises(PipelineError, match=r"front.video\.mp4.*320x240.*640x480"):
+        _run([front, side], tmp_path / "big.toml", tmp_path / "b")
+    slow = _copy_frames(side, tmp_path / "rate" / "side" / "video.mp4", fps=12.5)
+    with pytest.raises(PipelineError, match=r"rate.side.video\.mp4.*12\.5 fps differs.*25 fps"):
+        _run([front, slow], cal, tmp_path / "c")
+    short = _copy_frames(side, tmp_path / "short" / "side" / "video.mp4", n=50)
+    with pytest.raises(PipelineError, match=r"short.side.video\.mp4: 50 frames but .*front.video\.mp4 has 101"):
+        _run([front, short], cal, tmp_path / "d")
+    with pytest.raises(PipelineError, match="calibration"):
+        capture([str(front), str(side)], tmp_path / "e", backend="markers", progress=False)
+    assert not (tmp_path / "a").exists() and not (tmp_path / "d").exists()
+
+
+def test_command_line_mismatch_is_one_line_exit_2(two_views, tmp_path):
+    _, root = two_views
+    other = shutil.copy(root / "side" / "video.mp4", tmp_path / "other.mp4")
+    r = CliRunner().invoke(
+        main,
+        ["capture", str(root / "front" / "video.mp4"), str(other), "-o", str(tmp_path / "c"), "--backend", "markers",
+         "--calibration", str(root / "cameras.toml"), "--no-effort", "--tempo", "60"],
+    )  # fmt: skip
+    assert r.exit_code == 2, r.output
+    errors = [ln for ln in r.output.splitlines() if "error" in ln]
+    assert len(errors) == 1 and errors[0].startswith("c2n: error:") and "other.mp4" in errors[0]
+
+
+@pytest.mark.slow
+def test_two_view_blazepose_capture_of_a_phrase_agrees_with_its_score(tmp_path):
+    """Front + side, BlazePose, 640x480, the renders' cameras given: Figure 7."""
+    from capture2notation.compare.agreement import compare_scores
+
+    score, root = _render(tmp_path, (640, 480), style="mannequin")
+    res = capture(
+        [root / v / "video.mp4" for v in VIEWS], tmp_path / "out", tempo=score.tempo,
+        calibration=root / "cameras.toml", progress=False, effort=False, overlay=False,
+    )  # fmt: skip
+    # Issue 15: one view reaches at best 80 % (front) on whole phrases; a second camera must beat that.
+    assert compare_scores(score, res.score).symbol_agreement > 0.80
+    # And its joints must be nearer the truth than the front camera's alone (calibrated likewise).
+    one = capture(
+        root / "front" / "video.mp4", tmp_path / "one", tempo=score.tempo, calibration=root / "cameras.toml",
+        progress=False, effort=False, overlay=False,
+    )  # fmt: skip
+    truth = np.asarray(read_truth(root / "front" / "truth.npz").joints)
+
+    def mpjpe(m):
+        return float(np.nanmean(np.linalg.norm(np.asarray(m.motion.joints) - truth, axis=-1)))
+
+    assert mpjpe(res) < mpjpe(one)
