@@ -199,6 +199,7 @@ def load_motion(
     seconds = {}
     if kind == "video":
         from capture2notation.fitting import Camera, fit_track
+        from capture2notation.fitting.camera import undistort_track
         from capture2notation.keypoints import extract
 
         known = None
@@ -209,12 +210,14 @@ def load_motion(
         t0 = time.perf_counter()
         track = extract(path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test)
         seconds["keypoints"] = time.perf_counter() - t0
-        camera = None
+        camera, pinhole = None, track
         if known is not None:
-            camera = Camera.from_calibration(known, path, track.image_size)
+            # The fit sees the keypoints through a pinhole; the overlay keeps the image's own pixels.
+            pinhole = undistort_track(track, known, path)
+            camera = Camera.from_calibration(known, path, track.image_size, undistorted=True)
             log.info("capture: using the camera of %s", calibration)
         t0 = time.perf_counter()
-        motion = fit_track(track, camera=camera)
+        motion = fit_track(pinhole, camera=camera)
         if floor is not None:
             motion = _lowered(motion, floor)
         seconds["fitting"] = time.perf_counter() - t0

@@ -157,6 +157,7 @@ def _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor: fl
     from capture2notation.body import JOINTS
     from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
     from capture2notation.fitting import Camera, fit_track
+    from capture2notation.fitting.camera import undistort_track
     from capture2notation.io.calibration import read_calibration
 
     missing = jconf == 0
@@ -179,7 +180,9 @@ def _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor: fl
         crops=track.crops[span],
         identity_confidence=np.asarray(track.identity_confidence)[span],
     )
-    camera = Camera.from_calibration(read_calibration(calibration), videos[best], track.image_size)
+    known = read_calibration(calibration)
+    cut = undistort_track(cut, known, videos[best])
+    camera = Camera.from_calibration(known, videos[best], track.image_size, undistorted=True)
     mono = fit_track(cut, camera=camera)
     log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
     fill = missing & np.all(np.isfinite(mono.joints), axis=-1)

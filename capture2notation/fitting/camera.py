@@ -14,13 +14,13 @@ performer (on +y, looking towards −y) at :data:`DEFAULT_DISTANCE` and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import FittingError
 
-__all__ = ["DEFAULT_DISTANCE", "DEFAULT_HEIGHT", "DEFAULT_HFOV_DEG", "Camera"]
+__all__ = ["DEFAULT_DISTANCE", "DEFAULT_HEIGHT", "DEFAULT_HFOV_DEG", "Camera", "calibrated_camera", "undistort_track"]
 
 #: Largest distortion coefficient the pinhole fit ignores: at 1e-3 a point at
 #: the image corner moves by well under a pixel at phone resolutions.
@@ -117,7 +117,7 @@ class Camera:
         return cls(get("K"), get("R"), get("t"), tuple(int(v) for v in np.asarray(get("image_size")).tolist()))
 
     @classmethod
-    def from_calibration(cls, calibration, video, image_size) -> Camera:
+    def from_calibration(cls, calibration, video, image_size, undistorted: bool = False) -> Camera:
         """The camera of `video` in a calibration (``capture2notation.io.calibration``).
 
         Parameters
@@ -131,32 +131,30 @@ class Camera:
         image_size : (int, int)
             (width, height) of the clip's frames, pixels; must equal the
             calibration's (a calibration of other images does not describe them).
+        undistorted : bool
+            The clip's keypoints have had the lens distortion removed
+            (:func:`undistort_track`); only then is a camera with distortion
+            accepted, as its pinhole part.
 
         Raises
         ------
         FittingError
             No camera of that name, or other image sizes.  Distortion is not
-            modelled by the fit: a calibration with distortion is refused.
+            modelled by the fit: a calibration with distortion is refused
+            unless the keypoints were undistorted.
         """
-        from ..errors import CalibrationError
-        from ..io.calibration import camera_name
-
-        names = calibration.names
-        name = names[0] if len(names) == 1 else camera_name(video)
-        try:
-            cam = calibration[name]
-        except CalibrationError as exc:
-            raise FittingError(f"{video}: {exc}") from None
+        cam = calibrated_camera(calibration, video)
+        name = cam.name
         size = tuple(int(v) for v in image_size)
         if tuple(cam.image_size) != size:
             raise FittingError(
                 f"{video}: frames are {size[0]}x{size[1]} but camera {name!r} is calibrated for "
                 f"{cam.image_size[0]}x{cam.image_size[1]}"
             )
-        if np.any(np.abs(cam.dist) > _MAX_IGNORED_DISTORTION):
+        if not undistorted and np.any(np.abs(cam.dist) > _MAX_IGNORED_DISTORTION):
             raise FittingError(
                 f"{video}: camera {name!r} has lens distortion {np.round(cam.dist, 4).tolist()}; "
-                "undistort the clip first (the fit models a pinhole camera)"
+                "undistort the keypoints first (undistort_track; the fit models a pinhole camera)"
             )
         return cls(np.asarray(cam.K), np.asarray(cam.R), np.asarray(cam.t), size)
 
@@ -196,3 +194,69 @@ class Camera:
         y = (uv[..., 1] - self.K[1, 2]) / self.K[1, 1] * depth
         c = np.stack([x, y, depth], axis=-1)
         return (c - self.t) @ self.R
+
+
+def calibrated_camera(calibration, video):
+    """The calibration's camera of `video`: its only camera, or the one named after the clip.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    video : str or Path
+        Named by :func:`~capture2notation.io.calibration.camera_name`.
+
+    Returns
+    -------
+    CameraCalibration
+
+    Raises
+    ------
+    FittingError
+        The calibration has several cameras and none of that name.
+    """
+    from ..errors import CalibrationError
+    from ..io.calibration import camera_name
+
+    names = calibration.names
+    name = names[0] if len(names) == 1 else camera_name(video)
+    try:
+        return calibration[name]
+    except CalibrationError as exc:
+        raise FittingError(f"{video}: {exc}") from None
+
+
+def undistort_track(track, calibration, video):
+    """`track` with its pixels as the calibration's pinhole camera would see them.
+
+    The fit projects through a pinhole (:class:`Camera`); a calibrated lens's
+    distortion is removed from the keypoints instead (OpenCV's
+    ``undistortPoints`` onto the same intrinsics), as multi-camera systems
+    do before triangulating.  Missing keypoints stay NaN; a camera without
+    distortion returns `track` unchanged.
+
+    Parameters
+    ----------
+    track : KeypointTrack
+    calibration : Calibration
+    video : str or Path
+        The clip, naming its camera (:func:`calibrated_camera`).
+
+    Returns
+    -------
+    KeypointTrack
+    """
+    import cv2
+
+    cam = calibrated_camera(calibration, video)
+    dist = np.asarray(cam.dist, float)
+    if not np.any(dist != 0.0):
+        return track
+    xy = np.array(track.xy, dtype=float, copy=True)
+    uv = xy[..., :2].reshape(-1, 2)
+    ok = np.all(np.isfinite(uv), axis=1)
+    if ok.any():
+        K = np.asarray(cam.K, float)
+        out = cv2.undistortPoints(uv[ok].reshape(-1, 1, 2), K, dist, P=K)
+        uv[ok] = out.reshape(-1, 2)
+    xy[..., :2] = uv.reshape(xy.shape[:-1] + (2,))
+    return replace(track, xy=xy)

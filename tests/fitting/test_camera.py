@@ -1,5 +1,7 @@
 """Pinhole camera: projection geometry, round trips and input errors."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -60,3 +62,48 @@ def test_bad_cameras_are_rejected(kwargs, message):
         Camera(**kwargs)
     with pytest.raises(FittingError, match=r"missing|no camera field"):
         Camera.from_truth({"K": np.eye(3)})
+
+
+def _distorted_calibration(dist):
+    from capture2notation.io.calibration import Calibration, CameraCalibration
+
+    cam = Camera.default((640, 480))
+    return cam, Calibration.of(
+        [CameraCalibration("front", (640, 480), cam.K, np.asarray(dist, float), cam.R, np.asarray(cam.t))]
+    )
+
+
+def test_undistorted_keypoints_are_the_pinhole_projection():
+    """A calibrated lens (k1, k2 as `c2n calibrate` fits them) bends the
+    keypoints; undistorted onto the same intrinsics they are where the fit's
+    pinhole camera projects the same points (OpenCV's own projection as the
+    reference), and a missing keypoint stays missing."""
+    import cv2
+
+    from capture2notation.fitting.camera import undistort_track
+    from capture2notation.keypoints import KeypointTrack
+
+    dist = [-0.11, 0.09, 0.0, 0.0, 0.0]
+    cam, cal = _distorted_calibration(dist)
+    rng = np.random.default_rng(0)
+    pts = np.column_stack([rng.uniform(-1.0, 1.0, 66), rng.uniform(-0.3, 0.3, 66), rng.uniform(0.1, 1.8, 66)])
+    rvec, _ = cv2.Rodrigues(cam.R)
+    seen, _ = cv2.projectPoints(pts.reshape(-1, 1, 3), rvec, np.asarray(cam.t, float), cam.K, np.asarray(dist))
+    track = KeypointTrack.empty(2, 25.0, (640, 480), backend="blazepose")
+    xy = track.xy.copy()
+    xy[..., :2] = seen.reshape(2, 33, 2)
+    xy[1, 5, :2] = np.nan
+    out = undistort_track(replace(track, xy=xy), cal, "front.mp4")
+    pinhole = cam.project(pts).reshape(2, 33, 2)
+    moved = np.nanmax(np.linalg.norm(xy[..., :2] - pinhole, axis=-1))
+    assert moved > 2.0  # the lens moves them by pixels
+    err = np.linalg.norm(out.xy[..., :2] - pinhole, axis=-1)
+    assert np.nanmax(err) < 0.01 and np.isnan(out.xy[1, 5, :2]).all()
+
+
+def test_a_distorted_camera_needs_undistorted_keypoints():
+    cam, cal = _distorted_calibration([-0.11, 0.09, 0.0, 0.0, 0.0])
+    with pytest.raises(FittingError, match="has lens distortion"):
+        Camera.from_calibration(cal, "front.mp4", (640, 480))
+    pinhole = Camera.from_calibration(cal, "front.mp4", (640, 480), undistorted=True)
+    np.testing.assert_allclose(pinhole.K, cam.K)
