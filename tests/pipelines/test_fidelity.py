@@ -16,22 +16,6 @@ from pipelines.fidelity.config import StudyConfig, load_config, quick
 from pipelines.fidelity.measure import builtin_scores, kept_frames, perform
 from pipelines.fidelity.runner import run_condition, run_study
 
-TINY = dict(
-    phrases=("figure7",),
-    emotions=("happy", "sad"),
-    takes=2,
-    training_takes=2,
-    capture="truth",
-    frame_rates=(25, 5),
-    resampling=("keyframe",),
-    image_sizes=((320, 240),),
-    views=("front",),
-    compression=(0,),
-    noise=(0.0,),
-    bootstrap=3,
-    baseline={"frame_rate": 25, "image_size": (320, 240), "view": "front", "compression": 0, "noise": 0.0},
-)
-
 
 def test_config_from_toml_and_errors(tmp_path):
     p = tmp_path / "study.toml"
@@ -127,8 +111,8 @@ def test_kept_frames_contain_key_frames():
     assert ends <= set(kept.tolist()) | {motion.n_frames}
 
 
-def test_same_seed_same_results_and_resume(tmp_path):
-    cfg = StudyConfig(**TINY)
+def test_same_seed_same_results_and_resume(tmp_path, tiny_study):
+    cfg = StudyConfig(**tiny_study)
     a = run_study(cfg, tmp_path / "a", workers=1, progress=False)
     text = (tmp_path / "a" / "results.csv").read_text()
     jobs = {k: v for k, v in a.summary["jobs"].items() if k != "job_seconds"}
@@ -147,9 +131,9 @@ def test_same_seed_same_results_and_resume(tmp_path):
 
 
 @pytest.mark.slow
-def test_dask_cluster_gives_the_same_results(tmp_path):
+def test_dask_cluster_gives_the_same_results(tmp_path, tiny_study):
     distributed = pytest.importorskip("dask.distributed")
-    cfg = StudyConfig(**{**TINY, "emotions": ("happy", "angry"), "frame_rates": (25,)})
+    cfg = StudyConfig(**{**tiny_study, "emotions": ("happy", "angry"), "frame_rates": (25,)})
     run_study(cfg, tmp_path / "local", workers=1, progress=False)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
         dask = run_study(cfg, tmp_path / "dask", scheduler=cl.scheduler_address, progress=False)
@@ -157,8 +141,8 @@ def test_dask_cluster_gives_the_same_results(tmp_path):
     assert (tmp_path / "dask" / "results.csv").read_text() == (tmp_path / "local" / "results.csv").read_text()
 
 
-def test_unreachable_scheduler_is_a_one_line_error(tmp_path):
-    cfg = StudyConfig(**TINY)
+def test_unreachable_scheduler_is_a_one_line_error(tmp_path, tiny_study):
+    cfg = StudyConfig(**tiny_study)
     with pytest.raises(PipelineError, match="Dask scheduler"):
         run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False, connect_timeout=2)
 

@@ -15,25 +15,9 @@ from pipelines.cli import main
 from pipelines.fidelity.config import StudyConfig
 from pipelines.fidelity.runner import run_study
 
-TINY = dict(
-    phrases=("figure7",),
-    emotions=("happy", "sad"),
-    takes=2,
-    training_takes=2,
-    capture="truth",
-    frame_rates=(25, 5),
-    resampling=("keyframe",),
-    image_sizes=((320, 240),),
-    views=("front",),
-    compression=(0,),
-    noise=(0.0,),
-    bootstrap=3,
-    baseline={"frame_rate": 25, "image_size": (320, 240), "view": "front", "compression": 0, "noise": 0.0},
-)
 
-
-def test_corrupt_and_foreign_cache_files_are_rerun_with_a_warning(tmp_path, caplog):
-    cfg = StudyConfig(**TINY)
+def test_corrupt_and_foreign_cache_files_are_rerun_with_a_warning(tmp_path, caplog, tiny_study):
+    cfg = StudyConfig(**tiny_study)
     run_study(cfg, tmp_path, workers=1, progress=False)
     text = (tmp_path / "results.csv").read_text()
     files = sorted((tmp_path / "cache").glob("*.json"))
@@ -52,7 +36,7 @@ def test_corrupt_and_foreign_cache_files_are_rerun_with_a_warning(tmp_path, capl
     assert sum("not a result row" in w for w in warned) == 2 and sum("another job" in w for w in warned) == 1
     assert (tmp_path / "results.csv").read_text() == text  # rerun gives the same rows
     # A row of another configuration (another seed) under this study's names is rerun too.
-    seeded = StudyConfig(**{**TINY, "seed": 1})
+    seeded = StudyConfig(**{**tiny_study, "seed": 1})
     mine = run_study(seeded, tmp_path / "s1", workers=1, progress=False)
     assert mine.summary["jobs"]["ran"] == 12
     for f, g in zip(sorted((tmp_path / "s1" / "cache").glob("*.json")), sorted((tmp_path / "cache").glob("*.json"))):
@@ -171,7 +155,7 @@ def _wait_gone(pids, seconds=HANG_S) -> list[int]:
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 @pytest.mark.filterwarnings("ignore:feet on the floor")  # the segmenter's note on a short phrase, not our subject
-def test_ctrl_c_stops_keeps_finished_jobs_and_a_rerun_reuses_them(tmp_path):
+def test_ctrl_c_stops_keeps_finished_jobs_and_a_rerun_reuses_them(tmp_path, tiny_study):
     proc, cache = _start(tmp_path)
     workers = _children(proc.pid)
     os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does
@@ -184,7 +168,7 @@ def test_ctrl_c_stops_keeps_finished_jobs_and_a_rerun_reuses_them(tmp_path):
     assert "interrupted by SIGINT" in last and f"{len(kept)} of {TOTAL} jobs" in last and "again to resume" in last
     assert "Traceback" not in err
     assert len(workers) == 2 and not _wait_gone(workers, 10)
-    res = run_study(StudyConfig(**{**TINY, "capture": "keypoints"}), tmp_path / "out", workers=2, progress=False)
+    res = run_study(StudyConfig(**{**tiny_study, "capture": "keypoints"}), tmp_path / "out", workers=2, progress=False)
     assert res.summary["jobs"]["cached"] == len(kept) and res.summary["jobs"]["ran"] == TOTAL - len(kept)
     assert all((cache / name).read_text() == text for name, text in kept.items())
 
@@ -204,11 +188,11 @@ def test_killing_the_parent_leaves_no_worker_behind(tmp_path, sig):
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:feet on the floor")
-def test_two_capture_paths_are_run_and_compared_per_condition(tmp_path):
+def test_two_capture_paths_are_run_and_compared_per_condition(tmp_path, tiny_study):
     from pipelines.fidelity import run_fidelity_study
     from pipelines.fidelity.report import capture_comparison
 
-    cfg = StudyConfig(**{**TINY, "capture": ("truth", "keypoints")})
+    cfg = StudyConfig(**{**tiny_study, "capture": ("truth", "keypoints")})
     res = run_fidelity_study(cfg, tmp_path, workers=1, progress=False)
     assert list(res.by_capture) == ["truth", "keypoints"] and res.summary["capture"] == "truth"
     assert res.summary["other_captures"]["keypoints"]["jobs"]["total"] == 12
