@@ -464,33 +464,16 @@ def notate(
     seen = feet_seen(motion)
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
     given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
+    # The same reading with the tempo given or, where none can be found, one beat a second.
+    common = dict(meter=meter, params=params, title=title, axes=axes, feet_seen=seen)
     try:
-        seg = segment_motion(
-            joints,
-            fps,
-            tempo=given,
-            meter=meter,
-            params=params,
-            title=title,
-            tempo_evidence=evidence,
-            axes=axes,
-            feet_seen=seen,
-        )
+        seg = segment_motion(joints, fps, tempo=given, tempo_evidence=evidence, **common)
     except QuantiseError as exc:
         if tempo is not None:
             raise
         # Too few movements for a beat: time as it is, one beat a second, and say so.
         log.warning("capture: no beat found (%s): writing %d bpm, one beat a second", exc, SECONDS_TEMPO)
-        seg = segment_motion(
-            joints,
-            fps,
-            tempo=Fraction(SECONDS_TEMPO),
-            meter=meter,
-            params=params,
-            title=title,
-            axes=axes,
-            feet_seen=seen,
-        )
+        seg = segment_motion(joints, fps, tempo=Fraction(SECONDS_TEMPO), **common)
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)

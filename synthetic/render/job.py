@@ -152,6 +152,24 @@ def render_pose(
 CAMERA_FILE = "camera.toml"
 
 
+def perform_score(score, fps: float, body: Body, style: str, emotion: str | None = None):
+    """The score as the dancer performs it: `style` checked, `emotion` applied, the motion interpreted.
+
+    Returns
+    -------
+    score : Score
+        With the emotion's Effort when one is given.
+    motion : Motion
+    """
+    from ..interpret import interpret
+
+    if style not in STYLES:
+        raise SyntheticError(f"unknown style {style!r}; expected one of {', '.join(STYLES)}")
+    if emotion is not None:
+        score = score.with_emotion(emotion)
+    return score, interpret(score, fps, body)
+
+
 def write_camera_toml(camera: Camera, path, name: str) -> Path:
     """Write `camera` as a one-camera calibration file named `name` (no distortion)."""
     cam = CameraCalibration(
@@ -216,15 +234,9 @@ def render_score(
     """
     from capture2notation.notation.formats import dumps, write
 
-    from ..interpret import interpret
-
     if view not in VIEWS:
         raise SyntheticError(f"unknown view {view!r}; expected one of {', '.join(VIEWS)}")
-    if style not in STYLES:
-        raise SyntheticError(f"unknown style {style!r}; expected one of {', '.join(STYLES)}")
-    if emotion is not None:
-        score = score.with_emotion(emotion)
-    motion = interpret(score, fps, body or Body())
+    score, motion = perform_score(score, fps, body or Body(), style, emotion)
     outdir = Path(outdir)
     render_motion(
         motion,

@@ -24,7 +24,7 @@ from capture2notation.io.calibration import Calibration, CameraCalibration, writ
 
 from .board_clip import BOARD, FLOOR_MARGIN, board_path, floor_origin, render_board_clip
 from .camera import VIEWS, Camera
-from .job import STYLES, render_motion
+from .job import perform_score, render_motion
 
 __all__ = ["CAMERAS_FILE", "calibrate_command", "render_views"]
 
@@ -80,20 +80,14 @@ def render_views(
     """
     from capture2notation.notation.formats import dumps, write
 
-    from ..interpret import interpret
-
     views = list(views)
     if len(views) < 2 or len(set(views)) != len(views):
         raise SyntheticError(f"views {','.join(views)} must be two or more different names")
     for v in views:
         if v not in VIEWS:
             raise SyntheticError(f"unknown view {v!r}; expected some of {', '.join(VIEWS)}")
-    if style not in STYLES:
-        raise SyntheticError(f"unknown style {style!r}; expected one of {', '.join(STYLES)}")
-    if emotion is not None:
-        score = score.with_emotion(emotion)
     body = Body()
-    motion = interpret(score, fps, body)
+    score, motion = perform_score(score, fps, body, style, emotion)
     outdir = Path(outdir)
     cameras = [Camera.for_view(v, size, body.height) for v in views]
     for v, cam in zip(views, cameras):
