@@ -1,6 +1,8 @@
 """The capture job: video or motion file → notation files a notator can use.
 
-INPUT is a video file or image folder (keypoints → 3D fit), or a motion file
+INPUT is a video file or image folder (keypoints → 3D fit), a keypoint
+track saved by ``c2n keypoints`` (the same fit, without running the pose
+model again), or a motion file
 (BVH, Kinect v2 CSV, truth sidecar ``.npz``) read directly.  The motion is
 then quantised (:mod:`capture2notation.quantise`) and every output is
 written atomically into OUTDIR:
@@ -78,6 +80,9 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
+#: Input kinds whose joints are fitted to keypoints of one camera: a video
+#: (keypoints found here) or a keypoint track saved by ``c2n keypoints``.
+FITTED_KINDS = ("video", "keypoints")
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm", ".mpg", ".mpeg")
 MOTION_SUFFIXES = (".bvh", ".csv", ".npz")
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
@@ -91,7 +96,7 @@ class CaptureResult:
     ----------
     outdir : Path
     kind : str
-        ``"video"``, ``"bvh"``, ``"kinect"`` or ``"truth"``.
+        ``"video"``, ``"keypoints"``, ``"bvh"``, ``"kinect"``, ``"truth"`` or ``"multiview"``.
     score : Score
     segmentation : Segmentation
     motion : FitResult
@@ -132,7 +137,7 @@ class CaptureResult:
 
 
 def input_kind(path) -> str:
-    """Classify INPUT: ``video`` (file or image folder), ``bvh``, ``kinect`` or ``truth``.
+    """Classify INPUT: ``video`` (file or image folder), ``keypoints``, ``bvh``, ``kinect`` or ``truth``.
 
     Raises
     ------
@@ -152,13 +157,24 @@ def input_kind(path) -> str:
     ext = p.suffix.lower()
     if ext in VIDEO_SUFFIXES:
         return "video"
-    kinds = {".bvh": "bvh", ".csv": "kinect", ".npz": "truth"}
+    if ext == ".npz":
+        return "keypoints" if _is_keypoint_track(p) else "truth"
+    kinds = {".bvh": "bvh", ".csv": "kinect"}
     if ext in kinds:
         return kinds[ext]
     raise PipelineError(
         f"{p}: unknown input type {ext!r}; expected a video ({' '.join(VIDEO_SUFFIXES)}), an image folder, "
-        "a .bvh, a Kinect .csv or a truth .npz"
+        "a .bvh, a Kinect .csv, a keypoint track .npz (c2n keypoints) or a truth .npz"
     )
+
+
+def _is_keypoint_track(path: Path) -> bool:
+    """Whether an ``.npz`` is a keypoint track (``c2n keypoints``) rather than a truth sidecar."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return {"xy", "visibility", "presence", "world"} <= set(data.files)
+    except (OSError, ValueError) as exc:
+        raise PipelineError(f"{path}: cannot read .npz: {exc}") from exc
 
 
 def _with_fps(motion, fps: float):
@@ -197,10 +213,10 @@ def load_motion(
         Time spent in ``keypoints`` and ``fitting`` (or ``read``).
     """
     seconds = {}
-    if kind == "video":
+    if kind in FITTED_KINDS:
         from capture2notation.fitting import Camera, fit_track
         from capture2notation.fitting.camera import undistort_track
-        from capture2notation.keypoints import extract
+        from capture2notation.keypoints import KeypointTrack, extract
 
         known = None
         if calibration is not None:
@@ -208,7 +224,12 @@ def load_motion(
 
             known = read_calibration(calibration)
         t0 = time.perf_counter()
-        track = extract(path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test)
+        if kind == "keypoints":
+            track = KeypointTrack.load(path)
+            if fps_override is not None:
+                track = replace(track, fps=float(fps_override), times=np.arange(len(track)) / float(fps_override))
+        else:
+            track = extract(path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test)
         seconds["keypoints"] = time.perf_counter() - t0
         camera, pinhole = None, track
         if known is not None:
@@ -449,7 +470,7 @@ def notate(
     estimate, camera_source = camera
     # The body key is LabanotationSuite's reading of a Kinect's own arm
     # positions; the standard key keeps the fit throughout.
-    measured_arms = kind != "video" and axes == "body"
+    measured_arms = kind not in FITTED_KINDS and axes == "body"
     joints = joints_for_labels(motion) if measured_arms else np.asarray(motion.joints, dtype=float)
     fps = float(motion.fps)
     if not np.isfinite(joints).any():
@@ -557,7 +578,7 @@ def _write_outputs(
 
         files["overlay.mp4"] = write_overlay(input_path, track, outdir / "overlay.mp4", fps=track.fps)
     elif kind not in ("video", "multiview"):
-        skipped.append("overlay.mp4: no video (motion file input)")
+        skipped.append(f"overlay.mp4: no video ({kind} input)")
     return files, skipped
 
 

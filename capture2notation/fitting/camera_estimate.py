@@ -61,6 +61,11 @@ BLOCK_FRAMES = 25
 MIN_VISIBILITY = 0.5
 #: Fewest usable frames for an estimate.
 MIN_FRAMES = 10
+#: Most frames entering the estimate; a longer clip's usable frames are
+#: subsampled evenly across it.  Its errors are BlazePose's biases, which
+#: more frames of the same clip do not average away, so the cost (one focal
+#: search per bootstrap resample) and memory stay bounded for hours of video.
+MAX_FRAMES = 600
 
 _HIPS, _SHOULDERS = (23, 24), (11, 12)
 _LEG = ((23, 25, 27), (24, 26, 28))  # hip, knee, ankle (left, right)
@@ -84,7 +89,7 @@ class CameraEstimate:
     up : (3,) tuple of float
         The world's up direction in camera axes (the floor's normal).
     frames : int
-        Frames used.
+        Frames used (at most :data:`MAX_FRAMES`, evenly spread over the clip).
     contacts : int
         Frames whose lowest foot point was within 2 sd of the floor.
     """
@@ -222,6 +227,8 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
     frames = np.flatnonzero(seen[:, list(_FOOT)].any(1) & seen[:, list(_HIPS + _SHOULDERS)].all(1) & (seen.sum(1) >= 8))
     if len(frames) < MIN_FRAMES:
         return None
+    if len(frames) > MAX_FRAMES:
+        frames = frames[np.linspace(0, len(frames) - 1, MAX_FRAMES).round().astype(int)]
     uv = xy[frames] - np.array([w_img / 2, h_img / 2])
     wts = seen[frames].astype(float)
     Wf = np.where(seen[frames][..., None], W[frames], 0.0)

@@ -39,6 +39,7 @@ poor measure there), far from it the image length decides.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -207,7 +208,29 @@ def _hanging(cam: Camera, ok, s_px, e_px, w_px, depth, upper: float, fore: float
     return out
 
 
-def _remove_rest_offset(tw: np.ndarray, chain, hanging: np.ndarray, followers=()) -> None:
+def _clip_median(rest: dict | None, key, values: np.ndarray, where: np.ndarray) -> float:
+    """The median of `values` over `where`, or the clip's own where `rest` already holds it.
+
+    A long clip is fitted in spans (:mod:`.spans`); its rest offsets are a
+    property of the clip (the pose model's bias for this figure), measured
+    once over frames spread across it and then given to every span, so a
+    span does not carry an offset of its own.  `rest` None: measure here;
+    a dict: use its entry for `key` or, missing, measure and store it (NaN
+    when fewer than :data:`_MIN_REST_FRAMES` frames show the rest pose).
+    """
+    if rest is not None and key in rest:
+        return rest[key]
+    value = float("nan")
+    if np.sum(where) >= _MIN_REST_FRAMES:
+        with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slices: no offset
+            value = float(np.nanmedian(values[where]))
+    if rest is not None:
+        rest[key] = value
+    return value
+
+
+def _remove_rest_offset(tw: np.ndarray, chain, hanging: np.ndarray, followers=(), rest: dict | None = None) -> None:
     """Take out of the world targets `tw` (in place) the depth they give a limb that hangs.
 
     BlazePose's world landmarks put the elbow of an arm hanging straight
@@ -228,20 +251,23 @@ def _remove_rest_offset(tw: np.ndarray, chain, hanging: np.ndarray, followers=()
     hanging : (T,) ndarray of bool
     followers : sequence of int
         Targets that move with the end joint (hand tip; heel and toe).
+    rest : dict, optional
+        The clip's offsets (see :func:`_clip_median`).
     """
-    if hanging.sum() < _MIN_REST_FRAMES:
-        return
     a, m, e = chain
     carried = [tw[:, f] - tw[:, e] for f in followers]
-    segs = []
+    segs, offsets = [], []
     for i, j in ((a, m), (m, e)):
         d = tw[:, j] - tw[:, i]
         n = np.linalg.norm(d, axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
-            offset = np.nanmedian((d[:, 2] / n)[hanging])
+            offset = _clip_median(rest, ("world", i, j), d[:, 2] / n, hanging)
         if np.isfinite(offset):
             d[:, 2] -= offset * n
         segs.append(d)
+        offsets.append(offset)
+    if not np.isfinite(offsets).any():
+        return
     tw[:, m] = tw[:, a] + segs[0]
     tw[:, e] = tw[:, m] + segs[1]
     for f, c in zip(followers, carried):
@@ -249,7 +275,14 @@ def _remove_rest_offset(tw: np.ndarray, chain, hanging: np.ndarray, followers=()
 
 
 def remove_leg_rest_offsets(
-    model: PoseModel, cam: Camera, params: np.ndarray, names, tx: np.ndarray, tc: np.ndarray, tw: np.ndarray
+    model: PoseModel,
+    cam: Camera,
+    params: np.ndarray,
+    names,
+    tx: np.ndarray,
+    tc: np.ndarray,
+    tw: np.ndarray,
+    rest: dict | None = None,
 ) -> np.ndarray:
     """World targets with the depth they give a straight standing leg taken out (a copy).
 
@@ -269,6 +302,9 @@ def remove_leg_rest_offsets(
     tx : (T, N, 2) ndarray
     tc : (T, N) ndarray
     tw : (T, N, 3) ndarray
+    rest : dict, optional
+        The clip's rest offsets, measured once for a clip fitted in spans
+        (see :func:`_clip_median`); None measures them on these frames.
 
     Returns
     -------
@@ -294,7 +330,7 @@ def remove_leg_rest_offsets(
             float(np.linalg.norm(model.offsets[m_a])),
         )
         followers = [names.index(f"{side}_{j}") for j in ("heel", "toe") if f"{side}_{j}" in names]
-        _remove_rest_offset(tw, (i_h, i_k, i_a), hanging, followers)
+        _remove_rest_offset(tw, (i_h, i_k, i_a), hanging, followers, rest)
     return tw
 
 
@@ -314,6 +350,7 @@ def choose_arm_depths(
     image_z: np.ndarray | None,
     fps: float,
     opt: DepthOptions | None = None,
+    rest: dict | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Choose each arm's depth candidate per frame and write it into the world targets.
 
@@ -337,6 +374,8 @@ def choose_arm_depths(
         Relative depth of the image landmarks, pixels (+ away from the camera).
     fps : float
     opt : DepthOptions, optional
+    rest : dict, optional
+        As for :func:`remove_leg_rest_offsets`.
 
     Returns
     -------
@@ -379,7 +418,7 @@ def choose_arm_depths(
         w_px = np.where(seen[:, None], tx[:, i_w], s_px)
         if opt.rest_offset:
             hanging = _hanging(cam, seen & shown, s_px, e_px, w_px, depth, upper, fore)
-            _remove_rest_offset(tw, (i_s, i_e, i_w), hanging, (i_h,))
+            _remove_rest_offset(tw, (i_s, i_e, i_w), hanging, (i_h,), rest)
         E, W = arm_candidates(cam, S, e_px, w_px, upper, fore)  # (T, 4, 3)
         u_up, u_fore = _unit(E - S[:, None]), _unit(W - E)
         unary = np.zeros((T, 4))
@@ -400,10 +439,12 @@ def choose_arm_depths(
             px_per_m = cam.focal / np.maximum(depth, 0.1)
             dz_up = (z[:, 1] - z[:, 0]) / (px_per_m * upper)
             dz_fore = (z[:, 2] - z[:, 1]) / (px_per_m * fore)
-            if opt.rest_offset and (hanging & okz).sum() >= _MIN_REST_FRAMES:
+            if opt.rest_offset:
                 # The image landmarks' depth carries the same rest offset.
-                dz_up = dz_up - np.median(dz_up[hanging & okz])
-                dz_fore = dz_fore - np.median(dz_fore[hanging & okz])
+                off_up = _clip_median(rest, ("image_z", i_s, i_e), dz_up, hanging & okz)
+                off_fore = _clip_median(rest, ("image_z", i_e, i_w), dz_fore, hanging & okz)
+                if np.isfinite(off_up) and np.isfinite(off_fore):
+                    dz_up, dz_fore = dz_up - off_up, dz_fore - off_fore
             cost = (
                 (u_up[..., 2] - np.clip(np.nan_to_num(dz_up), -1, 1)[:, None]) ** 2
                 + (u_fore[..., 2] - np.clip(np.nan_to_num(dz_fore), -1, 1)[:, None]) ** 2

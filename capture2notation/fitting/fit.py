@@ -47,6 +47,7 @@ from .solver import (
     solve,
     to_result,
 )
+from .spans import PROPORTION_FRAMES, spread_frames, stitch, track_spans
 from .start import SKIP_DIRECTIONS, image_offsets, initial_params, world_weights
 from .temporal import coupled_params, smooth_root
 from .uncertainty import direction_spread, spread_factor, with_identity_confidence
@@ -304,21 +305,37 @@ def fit_keypoints(
             raise FittingError("fit_keypoints needs a camera or the image_size (width, height) for a default camera")
         camera = refine_focal(xy, conf, fps, Camera.default(image_size), world=world, body=body, options=opt)
     known = not set_floor
-    model, terms, (names, tx, tc, tw), use2 = _problem(xy, conf, world, body, camera, opt, floor=known)
-    if known and opt.sigma_floor > 0:
-        _floor_terms(model, terms, tc, names)
-    params0 = initial_params(model, camera, names, tx, tc, tw, floor=known)
-    if tw is not None:
-        tw = _impute_shoulders(model, camera, params0, names, tc, tw)
-        if opt.depth is not None:
-            # Decide which side of the image plane each arm segment lies on
-            # before the continuous solve, which only refines the side it
-            # starts on.
-            tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth)
-            if opt.depth.rest_offset:
-                tw = remove_leg_rest_offsets(model, camera, params0, names, tx, tc, tw)
-        _, terms.dirs, terms.wd = _direction_terms(names, tc, tw)
-        params0 = initial_params(model, camera, names, tx, tc, tw, floor=known)
+    # The camera and the figure's proportions belong to the whole clip; the
+    # rest is fitted span by span (:mod:`.spans`: bounded memory).
+    sel = spread_frames(xy.shape[0], PROPORTION_FRAMES)
+    names, tx, tc, tw = _targets_from_landmarks(xy[sel], conf[sel], None if world is None else world[sel], opt)
+    offsets = image_offsets(names, tx, tc, tw, camera, body, known)
+    times = np.arange(xy.shape[0]) / fps if times is None else np.asarray(times, float)
+    if times.shape != xy.shape[:1]:
+        raise FittingError(f"times must have shape ({xy.shape[0]},), got {times.shape}")
+    spans = track_spans(xy.shape[0], fps, opt.span_s, opt.context_s)
+    rest = None
+    if len(spans) > 1:
+        # The rest offsets too (the pose model's bias for this figure):
+        # measured once on the frames spread over the clip.
+        rest = {}
+        iz = None if image_z is None else image_z[sel]
+        wsel = None if world is None else world[sel]
+        _prepared(xy[sel], conf[sel], wsel, iz, fps, body, camera, known, offsets, opt, rest)
+    parts = []
+    for a, b, _, _ in spans:
+        iz = None if image_z is None else image_z[a:b]
+        wb = None if world is None else world[a:b]
+        parts.append(_fit_span(xy[a:b], conf[a:b], wb, iz, fps, times[a:b], body, camera, known, offsets, opt, rest))
+    result = stitch(parts, spans)
+    return _floored(result) if set_floor else result
+
+
+def _fit_span(xy, conf, world, image_z, fps, times, body, camera, known, offsets, opt, rest=None) -> FitResult:
+    """Fit frames with the clip's camera, proportions and rest offsets (see :func:`fit_keypoints`)."""
+    model, terms, names, tx, tc, use2, params0 = _prepared(
+        xy, conf, world, image_z, fps, body, camera, known, offsets, opt, rest
+    )
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
     params, cost = rewarm(model, params, cost, terms, fps, opt)
     for _ in range(opt.root_passes):
@@ -337,8 +354,36 @@ def fit_keypoints(
     if opt.spread_deg > 0:
         # A joint is only as sure as the direction of the segment it ends.
         joint_conf *= spread_factor(direction_spread(model, params, terms, fps, opt), opt.spread_deg)
-    result = to_result(model, params, fps, times, joint_conf, usable)
-    return _floored(result) if set_floor else result
+    return to_result(model, params, fps, times, joint_conf, usable)
+
+
+def _prepared(xy, conf, world, image_z, fps, body, camera, known, offsets, opt, rest):
+    """The fit's model, data terms and starting parameters of some frames.
+
+    The world targets' depths are chosen and their rest offsets removed
+    here (:mod:`.depth`); `rest` holds the clip's offsets (filled when
+    empty, see :func:`~.depth.remove_leg_rest_offsets`).
+
+    Returns
+    -------
+    model, terms, names, tx (T, N, 2), tc (T, N), use2 (N,), params0 (T, P)
+    """
+    model, terms, (names, tx, tc, tw), use2 = _problem(xy, conf, world, body, camera, opt, floor=known, offsets=offsets)
+    if known and opt.sigma_floor > 0:
+        _floor_terms(model, terms, tc, names)
+    params0 = initial_params(model, camera, names, tx, tc, tw, floor=known)
+    if tw is not None:
+        tw = _impute_shoulders(model, camera, params0, names, tc, tw)
+        if opt.depth is not None:
+            # Decide which side of the image plane each arm segment lies on
+            # before the continuous solve, which only refines the side it
+            # starts on.
+            tw, _ = choose_arm_depths(model, camera, params0, names, tx, tc, tw, image_z, fps, opt.depth, rest)
+            if opt.depth.rest_offset:
+                tw = remove_leg_rest_offsets(model, camera, params0, names, tx, tc, tw, rest)
+        _, terms.dirs, terms.wd = _direction_terms(names, tc, tw)
+        params0 = initial_params(model, camera, names, tx, tc, tw, floor=known)
+    return model, terms, names, tx, tc, use2, params0
 
 
 #: Model points that can touch the floor.
@@ -450,8 +495,11 @@ def _quick_cost(xy, conf, fps, cam, world, body, opt) -> float:
     return float(np.sum(cost))
 
 
-def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor: bool = False):
+def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor: bool = False, offsets=None):
     """Model with the clip's segment lengths and the data terms of a 2D fit.
+
+    `offsets` (J, 3) are the clip's proportions when already measured
+    (:func:`~.start.image_offsets`), else they are measured on these frames.
 
     Returns
     -------
@@ -462,7 +510,8 @@ def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor
         Targets with a reprojection term.
     """
     names, tx, tc, tw = _targets_from_landmarks(xy, conf, world, opt)
-    offsets = image_offsets(names, tx, tc, tw, camera, body, floor)
+    if offsets is None:
+        offsets = image_offsets(names, tx, tc, tw, camera, body, floor)
     model = PoseModel(body, offsets)
     w_targets = np.array([t[2] for t in TARGETS_2D])
     use2 = w_targets > 0

@@ -29,6 +29,7 @@ from .camera import Camera
 from .depth import DepthOptions
 from .model import PoseModel
 from .result import FitResult
+from .spans import CONTEXT_S, SPAN_S
 
 __all__ = ["FitOptions", "Terms", "rewarm", "solve", "to_result"]
 
@@ -106,6 +107,9 @@ class FitOptions:
         Frames with fewer usable targets are returned as NaN.
     min_confidence : float
         Landmarks below this confidence are ignored.
+    span_s, context_s : float
+        Seconds of a long clip fitted at once, and of context on each side
+        (:mod:`~capture2notation.fitting.spans`: bounded memory).
     depth : DepthOptions or None
         Weights of the choice of each arm's side of the image plane
         (:mod:`~capture2notation.fitting.depth`) made before the solve when
@@ -146,6 +150,8 @@ class FitOptions:
     polish_iterations: int = 3
     min_targets: int = 6
     min_confidence: float = 0.1
+    span_s: float = SPAN_S
+    context_s: float = CONTEXT_S
     depth: DepthOptions | None = field(default_factory=DepthOptions)
 
 

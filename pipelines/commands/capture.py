@@ -116,7 +116,7 @@ def capture(
     floor,
     offsets,
 ):
-    """Turn INPUT (a video, image folder, BVH, Kinect CSV or truth sidecar .npz)
+    """Turn INPUT (a video, image folder, keypoint track .npz from c2n keypoints, BVH, Kinect CSV or truth .npz)
     into notation files in OUTDIR.  Several video clips of calibrated cameras
     (--calibration naming each clip's camera) are triangulated into one capture."""
     from fractions import Fraction
