@@ -30,10 +30,11 @@ from .curves import (
 from .domain import EmotionDomain, emotion_domain
 from .emotion import SPREAD, emotion_probabilities, features
 from .fit import SpaceEstimate
+from .passages import PASSAGE_S, consensus, passage_index, thinned
 from .pooled import PooledEffort, curve_space, pool_curves, pooled_space
 from .posterior import Posterior, sample_posteriors
 
-__all__ = ["EffortResult", "MovementEffort", "estimate_effort", "movement_windows"]
+__all__ = ["EffortResult", "MovementEffort", "Passage", "estimate_effort", "movement_windows"]
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +64,22 @@ class MovementEffort:
 
 
 @dataclass(frozen=True)
+class Passage:
+    """The pooled Effort of one passage of a long clip (:mod:`.passages`).
+
+    Attributes
+    ----------
+    t_start, t_end : float
+        Seconds: the first movement's start, the last one's end.
+    pooled : PooledEffort
+    """
+
+    t_start: float
+    t_end: float
+    pooled: PooledEffort
+
+
+@dataclass(frozen=True)
 class EffortResult:
     """Everything ``effort.json`` reports.
 
@@ -82,6 +99,8 @@ class EffortResult:
     domain : EmotionDomain or None
         Whether the phrase is a port de bras the presets describe, check by
         check; the emotion is read only inside it.
+    passages : tuple of Passage
+        A long clip's passages, each pooled (empty for one passage).
     """
 
     movements: tuple
@@ -91,6 +110,7 @@ class EffortResult:
     emotion: dict | None
     skipped: tuple = field(default_factory=tuple)
     domain: EmotionDomain | None = None
+    passages: tuple = ()
 
     @property
     def emotion_text(self) -> str:
@@ -117,6 +137,7 @@ class EffortResult:
             "emotion_text": self.emotion_text,
             "emotion_domain": self.domain.to_dict() if self.domain is not None else None,
             "skipped": list(self.skipped),
+            "passages": [{"start_s": p.t_start, "end_s": p.t_end, **_pooled_dict(p.pooled)} for p in self.passages],
         }
 
 
@@ -225,6 +246,29 @@ def _sample_all(jobs, rng, workers: int, kw: dict, chunk: int | None = None) -> 
     return posts
 
 
+def _sample_passage(curves, rng, workers: int, kw: dict, per_movement: bool):
+    """Posteriors of one passage: each movement's (when `per_movement`), and its pooled groups by label.
+
+    A part pools when it has at least two movements and not all of them (a
+    part holding every movement pools to the phrase: sampled once).
+    """
+    by_part: dict[str, list] = {}
+    for c in curves:
+        by_part.setdefault(c.part, []).append(c)
+    groups = [(p, cs) for p, cs in by_part.items() if len(cs) >= 2 and len(cs) < len(curves)]
+    if curves:
+        groups.append(("phrase", curves))
+    jobs = [(c.tau, c.s, c.weight, None) for c in curves] if per_movement else []
+    n_mov = len(jobs)
+    jobs += [(t, s, w, g) for t, s, w, _, g in (pool_curves(cs) for _, cs in groups)]
+    posts = _sample_all(jobs, rng, workers, kw) if jobs else []
+    pooled = {label: post for (label, _), post in zip(groups, posts[n_mov:])}
+    if len(by_part) == 1 and len(curves) >= 2:
+        (only,) = by_part
+        pooled[only] = pooled["phrase"]
+    return posts[:n_mov], pooled
+
+
 def estimate_effort(
     joints,
     confidence,
@@ -239,6 +283,7 @@ def estimate_effort(
     snap: float = SNAP_S,
     refine: bool = True,
     max_points: int = MAX_CURVE_POINTS,
+    passage_s: float = PASSAGE_S,
 ) -> EffortResult:
     """Estimate Laban Effort per movement, pooled per part and phrase, and the emotion.
 
@@ -342,16 +387,22 @@ def estimate_effort(
     by_part: dict[str, list] = {}
     for c in curves:
         by_part.setdefault(c.part, []).append(c)
-    # a part holding every measured movement pools to the phrase: sample once
-    groups = [(p, cs) for p, cs in by_part.items() if len(cs) >= 2 and len(cs) < len(curves)]
-    if curves:
-        groups.append(("phrase", curves))
-
-    jobs = [(c.tau, c.s, c.weight, None) for c in curves] if per_movement else []
-    n_mov = len(jobs)
-    jobs += [(t, s, w, g) for t, s, w, _, g in (pool_curves(cs) for _, cs in groups)]
-    posts = _sample_all(jobs, rng, workers, kw) if jobs else []
-
+    # A long clip is sampled passage by passage (:mod:`.passages`): memory
+    # bounded, cost linear in its length.
+    passage = passage_index([c.t_start for c in curves], passage_s)
+    n_passages = int(passage.max()) + 1 if curves else 0
+    move_posts: list = []
+    pooled_posts: dict[str, list] = {}
+    spans = []
+    for k in range(n_passages):
+        members = [c for c, p in zip(curves, passage) if p == k]
+        posts, pooled = _sample_passage(members, rng, workers, kw, per_movement)
+        move_posts += [thinned(p) for p in posts] if n_passages > 1 else posts
+        for label, post in pooled.items():
+            pooled_posts.setdefault(label, []).append(post)
+        if n_passages > 1 and "phrase" in pooled:
+            t0, t1 = members[0].t_start, max(c.t_end for c in members)
+            spans.append(Passage(t0, t1, PooledEffort("phrase", len(members), pooled["phrase"], pooled_space(members))))
     movements = tuple(
         MovementEffort(
             part=sym.part,
@@ -361,11 +412,12 @@ def estimate_effort(
             posterior=post,
             space=curve_space(c),
         )
-        for sym, c, post in zip(syms, curves, posts[:n_mov])
+        for sym, c, post in zip(syms, curves, move_posts)
     )
     pooled_all = {}
-    for (label, cs), post in zip(groups, posts[n_mov:]):
-        pooled_all[label] = PooledEffort(label, len(cs), post, pooled_space(cs))
+    for label, posts in pooled_posts.items():
+        cs = curves if label == "phrase" else by_part[label]
+        pooled_all[label] = PooledEffort(label, len(cs), consensus(posts, rng), pooled_space(cs))
     phrase = pooled_all.pop("phrase", None)
     if phrase is not None and len(by_part) == 1 and len(curves) >= 2:
         (only,) = by_part
@@ -384,6 +436,7 @@ def estimate_effort(
         emotion=emotion,
         skipped=tuple(skipped),
         domain=domain,
+        passages=tuple(spans),
     )
 
 

@@ -121,3 +121,27 @@ def test_c2n_effort_command(angry, tmp_path):
     (tmp_path / "capture.npz").unlink()
     out = CliRunner().invoke(main, ["effort", str(tmp_path)])
     assert out.exit_code == 2 and "capture.npz" in out.output
+
+
+def test_a_long_clip_in_passages_keeps_the_phrase_effort():
+    # Eight movements of one Effort sampled in passages of about two
+    # movements: each passage pooled, the phrase their consensus, which must
+    # still hold the performed Effort (as the one-passage estimate does).
+    from capture2notation.effort.passages import KEEP_DRAWS
+
+    eff = Effort(time=-3.2, weight=0.45, space=1.0)
+    score = random_arm_score(np.random.default_rng(11), 8, tempo=90, effort=eff)
+    joints = arc_motion(score, 25.0)
+    joints = joints + 0.004 * np.random.default_rng(12).standard_normal(joints.shape)
+    whole = estimate_effort(joints, None, 25.0, score, rng=3)
+    parts = estimate_effort(joints, None, 25.0, score, rng=3, passage_s=float(score.seconds(2)))
+    assert not whole.passages and len(parts.passages) >= 3
+    assert sum(p.pooled.n_movements for p in parts.passages) == len(parts.movements) == 8
+    assert all(m.posterior.samples.shape[0] <= KEEP_DRAWS for m in parts.movements)
+    for res in (whole, parts):
+        b, x0 = res.pooled.posterior.summary(0), res.pooled.posterior.summary(1)
+        assert b["ci90"][0] <= eff.time <= b["ci90"][1]
+        assert x0["ci90"][0] <= eff.weight <= x0["ci90"][1]
+    data = parts.to_dict()
+    assert len(data["passages"]) == len(parts.passages)
+    assert data["passages"][0]["start_s"] < data["passages"][-1]["start_s"]
