@@ -319,6 +319,7 @@ def capture(
     calibration=None,
     floor: float | None = None,
     offsets=None,
+    workers: int = 1,
 ) -> CaptureResult:
     """Capture notation from a video or motion file, or from clips of several calibrated cameras.
 
@@ -348,6 +349,9 @@ def capture(
         Estimate Laban Effort (``effort.json``); the slowest step.
     seed : int
         Seed of the Effort posteriors.
+    workers : int
+        Processes sampling the Effort posteriors (the results do not
+        depend on it).
     overlay : bool
         Write ``overlay.mp4`` for video input.
     flip_test : bool
@@ -388,7 +392,7 @@ def capture(
             return notate(
                 motion, None, seconds, input_path=Path(input_path[0]), outdir=outdir, kind="multiview", tempo=tempo,
                 meter=meter, params=params, effort=effort, seed=seed, overlay=overlay, axes=axes,
-                camera=(None, source), extra_outputs=per_view,
+                camera=(None, source), extra_outputs=per_view, workers=workers,
             )  # fmt: skip
     elif offsets is not None:
         raise PipelineError("--offsets is for several clips (one per camera)")
@@ -426,6 +430,7 @@ def capture(
         overlay=overlay,
         axes=axes,
         camera=(estimate, camera_source),
+        workers=workers,
     )
 
 
@@ -446,6 +451,7 @@ def notate(
     axes: str = "standard",
     camera=(None, ""),
     extra_outputs=None,
+    workers: int = 1,
 ) -> CaptureResult:
     """Quantise fitted joints and write every output of a capture (after :func:`load_motion`).
 
@@ -510,7 +516,7 @@ def notate(
         if effort:
             t0 = time.perf_counter()
             try:
-                files.update(_write_effort(stage, seg.score, motion, seed))
+                files.update(_write_effort(stage, seg.score, motion, seed, workers))
             except C2NError as exc:
                 # Effort is an addition to the notation: report, keep the rest.
                 skipped.append(f"effort.json: {exc}")
@@ -608,11 +614,17 @@ def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = ""
     return path
 
 
-def _write_effort(outdir: Path, score: Score, motion, seed: int) -> dict:
+def _write_effort(outdir: Path, score: Score, motion, seed: int, workers: int = 1) -> dict:
     from capture2notation.effort import estimate_effort, write_effort
 
     result = estimate_effort(
-        motion.joints, motion.confidence, motion.fps, score, rng=np.random.default_rng(seed), times=motion.times
+        motion.joints,
+        motion.confidence,
+        motion.fps,
+        score,
+        rng=np.random.default_rng(seed),
+        times=motion.times,
+        workers=workers,
     )
     paths = write_effort(result, outdir, plots=True, rng=seed)
     return {Path(p).name: Path(p) for p in paths.values()}

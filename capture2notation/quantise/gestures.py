@@ -152,7 +152,14 @@ def _smooth(u: np.ndarray, window: int) -> np.ndarray:
 def _interval_speed(u_list: list[np.ndarray], x_list: list[np.ndarray], fps: float) -> np.ndarray:
     """Largest angular speed of the vectors and rate of the scalars over each interval, degrees per second."""
     per = [_angle_deg(u[:-1], u[1:]) for u in u_list] + [np.abs(np.diff(x)) for x in x_list]
-    return np.nanmax(np.stack(per), axis=0) * fps if per[0].size else np.zeros(0)
+    if not per[0].size:
+        return np.zeros(0)
+    stacked = np.stack(per)
+    # an interval where nothing was measured has no speed (NaN), not a warning
+    seen = np.isfinite(stacked).any(axis=0)
+    out = np.full(stacked.shape[1:], np.nan)
+    out[seen] = np.nanmax(stacked[:, seen], axis=0)
+    return out * fps
 
 
 def _scalar_noise(x: np.ndarray) -> float:

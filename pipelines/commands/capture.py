@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import click
@@ -65,6 +66,13 @@ FLOOR = FloorOrAuto()
 @click.option("--no-effort", is_flag=True, help="Skip the Laban Effort estimate (the slowest step).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Effort posteriors.")
 @click.option(
+    "--workers",
+    type=click.IntRange(1, 64),
+    default=min(os.cpu_count() or 1, 4),
+    show_default="this machine's cores, at most 4",
+    help="Processes sampling the Effort posteriors (the results do not depend on it).",
+)
+@click.option(
     "--flip-test",
     is_flag=True,
     help="BlazePose also reads a mirrored copy of each crop (more accurate in side views; slower).",
@@ -110,6 +118,7 @@ def capture(
     grid,
     no_effort,
     seed,
+    workers,
     flip_test,
     axes,
     calibration,
@@ -147,6 +156,7 @@ def capture(
         params=SegmentParams(grid=step),
         effort=not no_effort,
         seed=seed,
+        workers=workers,
         flip_test=flip_test,
         axes=axes,
         calibration=calibration,

@@ -227,6 +227,23 @@ def test_rendered_video_through_markers_backend(marker_render, calibrated, tmp_p
     assert 'src="overlay.mp4"' in (tmp_path / "c" / "index.html").read_text()
 
 
+def test_a_saved_keypoint_track_gives_the_video_capture(marker_render, tmp_path):
+    """``c2n keypoints`` then ``c2n capture TRACK.npz``: the video's score, without reading the video again."""
+    from capture2notation.keypoints import extract
+
+    track = extract(marker_render / "video.mp4", backend="markers", progress=False)
+    saved = track.save(tmp_path / "track.npz")
+    assert input_kind(saved) == "keypoints" and input_kind(marker_render / "truth.npz") == "truth"
+    from_video = capture(
+        marker_render / "video.mp4", tmp_path / "v", backend="markers", tempo=90, progress=False, effort=False
+    )
+    res = capture(saved, tmp_path / "k", tempo=90, progress=False, effort=False)
+    assert res.kind == "keypoints" and res.n_frames == from_video.n_frames
+    assert res.score.symbols == from_video.score.symbols
+    assert not (tmp_path / "k" / "overlay.mp4").exists()
+    assert any(s.startswith("overlay.mp4: no video (keypoints input)") for s in res.skipped)
+
+
 def test_render_writes_its_camera_as_a_calibration(marker_render):
     from capture2notation.io.calibration import read_calibration
     from capture2notation.io.truth import read_truth
