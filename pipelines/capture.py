@@ -13,7 +13,8 @@ written atomically into OUTDIR:
 ``laban_editor.json``  LabanotationSuite's LabanEditor score
 ``benesh.json``     Benesh key poses at every key frame
 ``labels.csv``      per-frame labels of every part
-``staff.svg/.png``  the Labanotation staff
+``staff.svg/.png``  the Labanotation staff (a long one continues on
+                    ``staff-2.png``, … pages)
 ``capture.npz``     keypoints (video input), fitted joints (T, J, 3), angles,
                     confidence (T, J), fps, times; for video the camera
                     estimate with its uncertainty (``camera_estimate``,
@@ -577,7 +578,9 @@ def _write_outputs(
     write_labels_csv(seg.labels, outdir / "labels.csv")
     files["labels.csv"] = outdir / "labels.csv"
     files["staff.svg"] = render_staff(score, outdir / "staff.svg", outdir / "staff.png")
-    files["staff.png"] = outdir / "staff.png"
+    # a long staff continues on further PNG pages: staff-2.png, ...
+    for page in sorted(outdir.glob("staff*.png")):
+        files[page.name] = page
     files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track, *camera)
     if kind == "video" and overlay and track is not None:
         from capture2notation.keypoints.overlay import write_overlay

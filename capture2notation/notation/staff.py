@@ -12,13 +12,15 @@ from pathlib import Path
 
 from ..errors import NotationError
 from .model import Score
-from .staff_draw import render_png, svg_text
+from .staff_draw import PAGE_STAVES, png_pages, render_png, svg_text
 from .staff_layout import FrontSign, Glyph, StaffLayout, staff_layout, symbol_outline, turn_outline
 
 __all__ = [
+    "PAGE_STAVES",
     "FrontSign",
     "Glyph",
     "StaffLayout",
+    "png_pages",
     "render_staff",
     "staff_layout",
     "svg_text",
@@ -47,7 +49,9 @@ def render_staff(
     png_path : str or Path, optional
         Output PNG of the same drawing (matplotlib, written atomically); the
         image has the layout's pixel size at ``dpi`` 100, scaled by
-        ``dpi / 100`` otherwise.
+        ``dpi / 100`` otherwise.  A staff of more than
+        :data:`~.staff_draw.PAGE_STAVES` staves continues on further pages,
+        ``STEM-2.png`` and on (:func:`~.staff_draw.png_pages`).
     beat_height, column_width : float
         Pixels per beat and per column.
     measures_per_staff : int or None

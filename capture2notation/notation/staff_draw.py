@@ -10,6 +10,7 @@ is drawn in grey with a dashed outline, so it reads as a guess at a glance.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
@@ -141,7 +142,8 @@ def svg_text(lay: StaffLayout) -> str:
         parts.append(f'<line x1="{x0:.2f}" y1="{y0:.2f}" x2="{x1:.2f}" y2="{y1:.2f}" stroke-width="{sw}"/>')
     parts.append("</g>")
     parts.append('<g class="labels" font-family="sans-serif">')
-    for x, y, text, size, anchor in lay.texts:
+    heading = [(lay.width / 2, y, text, size, "middle") for y, text, size in lay.heading]
+    for x, y, text, size, anchor in lay.texts + heading:
         parts.append(
             f'<text x="{x:.2f}" y="{y:.2f}" font-size="{size}" text-anchor={quoteattr(anchor)}>{_xml_text(text)}</text>'
         )
@@ -155,8 +157,8 @@ def svg_text(lay: StaffLayout) -> str:
     return "\n".join(parts) + "\n"
 
 
-def render_png(lay: StaffLayout, path, dpi: int) -> None:
-    """Write the layout as a PNG (layout pixels at 100 dpi, scaled by ``dpi / 100``), atomically."""
+def _render_page(lay: StaffLayout, path, dpi: int, x_range: tuple) -> None:
+    """Write the part of the layout between ``x_range`` (pixels) as a PNG, atomically."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -167,9 +169,25 @@ def render_png(lay: StaffLayout, path, dpi: int) -> None:
 
     # Layout units are pixels at 100 per inch; `dpi` only scales the raster.
     pt = 72.0 / 100.0
-    fig = Figure(figsize=(lay.width / 100.0, lay.height / 100.0), dpi=dpi)
+    xa, xb = x_range
+    fig = Figure(figsize=((xb - xa) / 100.0, lay.height / 100.0), dpi=dpi)
     ax = fig.add_axes((0, 0, 1, 1))
-    ax.set_xlim(0, lay.width)
+    ax.set_xlim(xa, xb)
+
+    def inside(x: float) -> bool:
+        return xa <= x < xb
+
+    # only what lies on the page is drawn (a long staff has many pages)
+    lay = StaffLayout(
+        width=lay.width,
+        height=lay.height,
+        staves=lay.staves,
+        glyphs=[g for g in lay.glyphs if inside(g.centre[0])],
+        lines=[ln for ln in lay.lines if max(ln[0], ln[2]) >= xa and min(ln[0], ln[2]) < xb],
+        texts=[t for t in lay.texts if inside(t[0])]
+        + [((xa + xb) / 2, y, t, size, "middle") for y, t, size in lay.heading],
+        fronts=[f for f in lay.fronts if inside(f.centre[0])],
+    )
     ax.set_ylim(lay.height, 0)
     ax.axis("off")
     for x0, y0, x1, y1, sw in lay.lines:
@@ -235,3 +253,35 @@ def render_png(lay: StaffLayout, path, dpi: int) -> None:
             ax.text(cx, cy + h + 9, f.room, fontsize=7 * pt, ha="center", va="baseline", parse_math=False)
         with atomic_path(path, suffix=".png") as tmp:
             fig.savefig(tmp, format="png", dpi=dpi)
+
+
+#: Staves on one PNG page: a long clip's staff is drawn page by page, so the
+#: raster (4 bytes a pixel) stays about 30 MB whatever the clip's length.
+PAGE_STAVES = 8
+
+
+def png_pages(path, n_pages: int) -> list:
+    """The PNG files of a staff of `n_pages` pages: `path`, then ``STEM-2.png``, ``STEM-3.png``, …"""
+    path = Path(path)
+    return [path] + [path.with_name(f"{path.stem}-{k}{path.suffix}") for k in range(2, n_pages + 1)]
+
+
+def render_png(lay: StaffLayout, path, dpi: int) -> list:
+    """Write the layout as PNG pages of :data:`PAGE_STAVES` staves (layout pixels at 100 dpi, scaled by ``dpi / 100``).
+
+    Returns
+    -------
+    list of Path
+        The pages written (atomically), in order (:func:`png_pages`).
+    """
+    staves = lay.staves or []
+    groups = [staves[i : i + PAGE_STAVES] for i in range(0, len(staves), PAGE_STAVES)] or [[]]
+    paths = png_pages(path, len(groups))
+    for k, (group, out) in enumerate(zip(groups, paths)):
+        # a page runs from halfway across the gap before its first staff to
+        # halfway across the gap after its last (the whole width on one page)
+        xa = 0.0 if k == 0 else 0.5 * (staves[k * PAGE_STAVES - 1].x_right + group[0].x_left)
+        last = (k + 1) * PAGE_STAVES
+        xb = lay.width if last >= len(staves) else 0.5 * (group[-1].x_right + staves[last].x_left)
+        _render_page(lay, out, dpi, (xa, xb))
+    return paths

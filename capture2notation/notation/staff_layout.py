@@ -174,6 +174,7 @@ class StaffLayout:
     lines: list = field(default_factory=list)  # (x0, y0, x1, y1, stroke width)
     texts: list = field(default_factory=list)  # (x, y, text, size, anchor)
     fronts: list = field(default_factory=list)  # FrontSign
+    heading: list = field(default_factory=list)  # (y, text, size): centred across the page
 
 
 def _columns(score: Score) -> dict:
@@ -403,14 +404,14 @@ def staff_layout(
                 lay.texts.append((xc, base + 26, _LABELS[part], 9, "middle"))
         lay.texts.append((cx - half / 2, base + 40, "L", 10, "middle"))
         lay.texts.append((cx + half / 2, base + 40, "R", 10, "middle"))
-    lay.texts.append((width / 2, 24, score.title or "untitled", 15, "middle"))
+    lay.heading.append((24, score.title or "untitled", 15))
     sub = f"\u2669 = {score.tempo}   meter {score.meter}"
     if score.emotion:
         sub += f"   {score.emotion}"
     elif score.effort is not None:
         e = score.effort
         sub += f"   effort b={e.time:g} x0={e.weight:g} S={e.space:g}"
-    lay.texts.append((width / 2, 46, sub, 11, "middle"))
+    lay.heading.append((46, sub, 11))
 
     pad = _PAD * column_width
     # Indexed once: which feet a turn is on, what overlaps what (no pairwise scans).

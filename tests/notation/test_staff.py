@@ -234,3 +234,27 @@ def test_empty_score_still_draws_a_staff(tmp_path):
     root = ET.parse(render_staff(Score(), tmp_path / "e.svg")).getroot()
     assert _symbol_groups(root) == []
     assert len(list(root.iter(f"{SVG}line"))) > 3
+
+
+def test_a_long_staff_continues_on_png_pages_that_tile_it(tmp_path):
+    import cv2
+
+    from capture2notation.notation.staff import PAGE_STAVES, png_pages
+
+    # one arm gesture a beat for 19 staves of one measure: three pages
+    n = 2 * PAGE_STAVES + 3
+    syms = tuple(Symbol(Fraction(b), Fraction(1), "right_arm", "forward", "high") for b in range(n * 2))
+    score = Score.from_symbols(syms, tempo=Fraction(60), meter=2)
+    lay = staff_layout(score, measures_per_staff=1)
+    assert len(lay.staves) == n
+    render_staff(score, tmp_path / "s.svg", tmp_path / "s.png", measures_per_staff=1)
+    pages = png_pages(tmp_path / "s.png", 3)
+    assert [p.name for p in pages] == ["s.png", "s-2.png", "s-3.png"]
+    assert not (tmp_path / "s-4.png").exists()
+    images = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) for p in pages]
+    # the pages tile the staff's width (a pixel of rounding each) at its height
+    assert abs(sum(im.shape[1] for im in images) - lay.width) <= len(images)
+    assert all(im.shape[0] == round(lay.height) for im in images)
+    # every page carries ink: its staves' lines and symbols (white is 255)
+    for im in images:
+        assert (im < 128).mean() > 0.01
