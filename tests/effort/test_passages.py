@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from capture2notation.effort.passages import consensus, passage_index, thinned
@@ -34,6 +34,7 @@ def test_passages_follow_the_window_starts_and_leave_none_empty():
         passage_index(starts, 0.0)
 
 
+@settings(deadline=None)
 @given(st.lists(st.floats(0, 1e5), min_size=1, max_size=200), st.floats(1.0, 1000.0))
 def test_passage_numbers_are_consecutive_and_ordered_in_time(starts, passage_s):
     idx = passage_index(starts, passage_s)

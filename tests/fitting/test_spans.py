@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from capture2notation.body import Body
@@ -18,6 +18,7 @@ from capture2notation.fitting.solver import CHUNK, FitOptions
 from capture2notation.fitting.spans import spread_frames, stitch, track_spans
 
 
+@settings(deadline=None)  # a long clip's spans take a while on a loaded machine
 @given(
     n=st.integers(1, 20000),
     fps=st.floats(1.0, 240.0),
