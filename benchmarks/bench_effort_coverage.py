@@ -36,6 +36,7 @@ import numpy as np
 from capture2notation.effort import estimate_effort
 from capture2notation.effort.emotion import PERFORMER_SD, TEMPERATURE, emotion_log_likelihoods
 from capture2notation.effort.estimate import _emotion_input
+from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
 from capture2notation.notation.effort import PRESETS
 from capture2notation.notation.model import Effort
 from synthetic.interpret import interpret
@@ -194,6 +195,12 @@ def main(argv=None) -> None:
     ap.add_argument("--smooth-mm", type=float, default=10.0)
     ap.add_argument("--rho", type=float, default=0.9)
     ap.add_argument("--no-refine", action="store_true", help="Keep the score's windows (no edge refinement).")
+    ap.add_argument(
+        "--rho-prior",
+        choices=("default", "capture"),
+        default="default",
+        help="Prior of the AR(1) rho: RHO_RANGE or CAPTURE_RHO_RANGE (a fitted capture's smooth error).",
+    )
     ap.add_argument("--max-points", type=int, help="Most samples per movement curve (default the module's).")
     ap.add_argument("--derive", action="store_true", help="Fit the temperature on the fitting set and use it.")
     ap.add_argument("--skip-coverage", action="store_true")
@@ -202,6 +209,8 @@ def main(argv=None) -> None:
     NOISE.update(white=a.white_mm / 1e3, smooth=a.smooth_mm / 1e3, rho=a.rho)
     if a.no_refine:
         ESTIMATE["refine"] = False
+    if a.rho_prior == "capture":
+        ESTIMATE["sampler_kw"] = {"rho_range": CAPTURE_RHO_RANGE}
     if a.max_points:
         ESTIMATE["max_points"] = a.max_points
     if not a.skip_coverage:
