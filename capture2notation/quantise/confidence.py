@@ -16,10 +16,10 @@ A symbol's confidence is the product of two factors, each in [0, 1]:
   camera's line of sight (a single camera measures depth worst; for a
   motion file or several cameras the error is isotropic), both widened
   by the held direction's own spread over the hold (the fit's jitter,
-  measured per symbol), and the body frame's yaw error
-  :data:`FRAME_YAW_SD_DEG` adds to the azimuth's.  For the small angles involved the elevation and
-  the azimuth errors are independent normals along the sphere's two
-  tangents, so the probability is the product of two normal interval
+  measured per symbol); with a single camera the body frame's yaw error
+  :data:`FRAME_YAW_SD_DEG` adds to the azimuth's.  For the small angles
+  involved the elevation and the azimuth errors are independent normals
+  along the sphere's two tangents, so the probability is the product of two normal interval
   probabilities — exact to first order in the error, and 0.5 at a boundary.
 
 A symbol whose confidence is below
@@ -41,6 +41,7 @@ from ..notation.model import DIRECTIONS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score
 __all__ = [
     "ANGLE_SD_DEG",
     "DEPTH_SD_DEG",
+    "FRAME_YAW_SD_DEG",
     "HOLD_S",
     "LEVEL_BOUNDARY_DEG",
     "SECTOR_HALF_DEG",
@@ -188,7 +189,9 @@ def direction_probability(held: np.ndarray, direction: str, level: str, depth: n
         "low": (-PLACE_BOUNDARY_DEG, -LEVEL_BOUNDARY_DEG),
     }[level]
     p_level = _normal_interval(lo, hi, el, sd_el)
-    sd_az = min(_AZIMUTH_SD_CAP_DEG, float(np.hypot(sd_along(t_az) / max(cos_el, 1e-6), FRAME_YAW_SD_DEG)))
+    sd_az = min(
+        _AZIMUTH_SD_CAP_DEG, float(np.hypot(sd_along(t_az) / max(cos_el, 1e-6), 0.0 if d is None else FRAME_YAW_SD_DEG))
+    )
     off = (az - float(DIRECTIONS[direction]) + 180.0) % 360.0 - 180.0
     p_sector = _normal_interval(-SECTOR_HALF_DEG, SECTOR_HALF_DEG, off, sd_az)
     return p_level * p_sector

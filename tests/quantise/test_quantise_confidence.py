@@ -55,8 +55,9 @@ def _p(x, lo, hi, sd):
 
 
 def _p_forward_low(el_deg: float) -> float:
-    """The stated model's probability for a still arm at azimuth 0, elevation `el_deg`, isotropic error."""
-    sd_az = np.hypot(ANGLE_SD_DEG / np.cos(np.radians(el_deg)), FRAME_YAW_SD_DEG)
+    """The stated model's probability for a still arm at azimuth 0, elevation `el_deg`, isotropic error
+    (no camera: no yaw error of a single view's body frame)."""
+    sd_az = ANGLE_SD_DEG / np.cos(np.radians(el_deg))
     return _p(el_deg, -67.5, -22.5, ANGLE_SD_DEG) * _p(0.0, -22.5, 22.5, sd_az)
 
 
@@ -95,7 +96,7 @@ def test_depth_along_the_line_of_sight_is_less_certain():
 def test_direction_probability_at_a_boundary_is_half_the_other_factor():
     held = _unit(22.5, 0.0)  # on the forward / right_forward boundary, middle level
     p = direction_probability(held, "forward", "middle")
-    sd_az = np.hypot(ANGLE_SD_DEG, FRAME_YAW_SD_DEG)
+    sd_az = ANGLE_SD_DEG
     assert p == pytest.approx(_p(0.0, -22.5, 22.5, ANGLE_SD_DEG) * _p(22.5, -22.5, 22.5, sd_az), abs=1e-6)
     assert direction_probability(held, "forward", "middle") == pytest.approx(
         direction_probability(held, "right_forward", "middle"), abs=1e-6
