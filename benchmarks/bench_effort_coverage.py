@@ -36,6 +36,7 @@ import numpy as np
 from capture2notation.effort import estimate_effort
 from capture2notation.effort.emotion import PERFORMER_SD, TEMPERATURE, emotion_log_likelihoods
 from capture2notation.effort.estimate import _emotion_input
+from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
 from capture2notation.notation.effort import PRESETS
 from capture2notation.notation.model import Effort
 from synthetic.interpret import interpret
@@ -48,6 +49,10 @@ X0_BANDS = ((0.3, 0.467), (0.467, 0.633), (0.633, 0.8))
 BEATS = (Fraction(1, 2), Fraction(1), Fraction(2), Fraction(4))
 #: Noise model of a fitted capture (set from the command line).
 NOISE = {"white": 0.005, "smooth": 0.010, "rho": 0.9}
+#: Options of ``estimate_effort`` under test (set from the command line):
+#: ``refine`` moves each window's edges onto the measured start and stop,
+#: ``max_points`` caps a curve's samples.
+ESTIMATE: dict = {}
 
 
 def noisy(joints: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -77,7 +82,7 @@ def coverage(n: int, seed: int) -> None:
             eff = Effort(float(rng.uniform(bl, bh)), float(rng.uniform(xl, xh)), 1.0)
             score = random_port_de_bras(rng, 2, tempo=60, effort=eff, beats=(beats,), head=0.0)
             joints = noisy(interpret(score, fps=FPS).joints(), rng)
-            res = estimate_effort(joints, None, FPS, score, rng=rng)
+            res = estimate_effort(joints, None, FPS, score, rng=rng, **ESTIMATE)
             for m in res.movements:
                 s0, s1 = m.posterior.summary(0), m.posterior.summary(1)
                 rows.append(
@@ -189,11 +194,25 @@ def main(argv=None) -> None:
     ap.add_argument("--white-mm", type=float, default=5.0)
     ap.add_argument("--smooth-mm", type=float, default=10.0)
     ap.add_argument("--rho", type=float, default=0.9)
+    ap.add_argument("--no-refine", action="store_true", help="Keep the score's windows (no edge refinement).")
+    ap.add_argument(
+        "--rho-prior",
+        choices=("default", "capture"),
+        default="default",
+        help="Prior of the AR(1) rho: RHO_RANGE or CAPTURE_RHO_RANGE (a fitted capture's smooth error).",
+    )
+    ap.add_argument("--max-points", type=int, help="Most samples per movement curve (default the module's).")
     ap.add_argument("--derive", action="store_true", help="Fit the temperature on the fitting set and use it.")
     ap.add_argument("--skip-coverage", action="store_true")
     ap.add_argument("--skip-emotion", action="store_true")
     a = ap.parse_args(argv)
     NOISE.update(white=a.white_mm / 1e3, smooth=a.smooth_mm / 1e3, rho=a.rho)
+    if a.no_refine:
+        ESTIMATE["refine"] = False
+    if a.rho_prior == "capture":
+        ESTIMATE["sampler_kw"] = {"rho_range": CAPTURE_RHO_RANGE}
+    if a.max_points:
+        ESTIMATE["max_points"] = a.max_points
     if not a.skip_coverage:
         coverage(a.n, a.seed)
     if not a.skip_emotion:

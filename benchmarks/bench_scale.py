@@ -131,9 +131,9 @@ def bench_video(seconds: float, workers: int, workdir: Path) -> None:
     cut = Fraction(round(seconds * TEMPO / 60))
     score = score.replace(symbols=tuple(s for s in score.symbols if s.end <= cut))
     write(score, workdir / "video_score.lab")
-    render = render_score(score, workdir / "video_render", progress=False)
+    video = render_score(score, workdir / "video_render", progress=False) / "video.mp4"
     out = workdir / "video_capture"
-    m = run_capture([render, "-o", out, "--tempo", TEMPO, "--workers", workers], workdir)
+    m = run_capture([video, "-o", out, "--tempo", TEMPO, "--workers", workers], workdir)
     duration = len(np.load(out / "capture.npz")["times"]) / 25.0
     print(f"\n## {duration:.0f}-s render, 640×480 25 fps, captured from the video with Effort ({workers} workers)\n")
     print("| wall s | × clip | CPU s | peak RSS (capture) | largest worker |")
@@ -192,7 +192,7 @@ def bench_spans(workdir: Path) -> None:
     for path in sorted(HOLDOUT.glob("*.lab")):
         score = read(path)
         render = render_score(score, workdir / "spans" / path.stem, progress=False)
-        track = extract(render, progress=False)
+        track = extract(render / "video.mp4", progress=False)
         scores = []
         for span in (np.inf, 5.0):
             motion = fit_track(track, options=dataclasses.replace(opt, span_s=span))

@@ -91,7 +91,16 @@ def _recovery_job(args):
         if est_kw.get("windows") == "captured":
             score = captured.replace(effort=score.effort)
     t0, c0 = time.perf_counter(), time.process_time()
-    res = estimate_effort(joints, conf, fps, score, rng=rng, times=times, refine=est_kw.get("refine", True))
+    res = estimate_effort(
+        joints,
+        conf,
+        fps,
+        score,
+        rng=rng,
+        times=times,
+        refine=est_kw.get("refine", True),
+        sampler_kw=est_kw.get("sampler_kw"),
+    )
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     rows = []
     for m in res.movements:
@@ -158,6 +167,10 @@ def recovery_through_capture(capture_fn, n_perf: int = 30, seed: int = 1974):
     return recovery(n_perf, seed, 0.0, 1, capture_fn=capture_fn, title="recovery through the capture path")
 
 
+#: Captures already made in this process (a second prior reads the same videos).
+_CAPTURED: dict = {}
+
+
 def blazepose_capture(score, fps=FPS, size=(640, 480), view="front"):
     """A `capture_fn` for :func:`recovery_through_capture`: render → BlazePose → 3D joints.
 
@@ -172,6 +185,13 @@ def blazepose_capture(score, fps=FPS, size=(640, 480), view="front"):
     captured : Score
         The capture's quantised ``score.lab``.
     """
+    key = (repr(score), fps, size, view)
+    if key not in _CAPTURED:
+        _CAPTURED[key] = _blazepose_capture(score, fps, size, view)
+    return _CAPTURED[key]
+
+
+def _blazepose_capture(score, fps, size, view):
     import tempfile
     from pathlib import Path
 
@@ -298,6 +318,12 @@ def main(argv=None):
         help="Through BlazePose: movement windows from the truth score or the captured (quantised) one.",
     )
     ap.add_argument("--no-refine", action="store_true", help="Use the score's windows as given (no refinement).")
+    ap.add_argument(
+        "--rho-prior",
+        choices=("default", "capture", "both"),
+        default="default",
+        help="Through BlazePose: the AR(1) rho prior RHO_RANGE, CAPTURE_RHO_RANGE, or both on the same captures.",
+    )
     a = ap.parse_args(argv)
     ESTIMATE_KW.update(windows=a.windows, refine=not a.no_refine)
     n_perf, n_emo = (6, 6) if a.quick else (40, 30)
@@ -308,7 +334,13 @@ def main(argv=None):
         recovery(n_perf, 1974, 0.0, a.workers)
         recovery(n_perf, 1974, 0.005, a.workers)
     if a.blazepose:
-        recovery_through_capture(blazepose_capture, n_perf=a.blazepose)
+        from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
+
+        priors = {"default": [None], "capture": [CAPTURE_RHO_RANGE], "both": [None, CAPTURE_RHO_RANGE]}[a.rho_prior]
+        for rho_range in priors:
+            ESTIMATE_KW["sampler_kw"] = None if rho_range is None else {"rho_range": rho_range}
+            print(f"\nrho prior: {'RHO_RANGE' if rho_range is None else 'CAPTURE_RHO_RANGE'}")
+            recovery_through_capture(blazepose_capture, n_perf=a.blazepose)
     if not a.skip_emotion:
         t0 = time.perf_counter()
         cal = emotion_set(n_emo, 2005, a.workers)

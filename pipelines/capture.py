@@ -432,7 +432,22 @@ def capture(
         axes=axes,
         camera=(estimate, camera_source),
         workers=workers,
+        line_of_sight=_line_of_sight(kind, calibration, input_path, track),
     )
+
+
+def _line_of_sight(kind: str, calibration, path, track) -> np.ndarray | None:
+    """A single camera's viewing axis in the fit's world, or None (motion files)."""
+    if kind not in FITTED_KINDS:
+        return None
+    if calibration is None:
+        # The fit's world has the camera on +y looking along -y (fitting.camera.Camera.default).
+        return np.array([0.0, 1.0, 0.0])
+    from capture2notation.fitting import Camera
+    from capture2notation.io.calibration import read_calibration
+
+    camera = Camera.from_calibration(read_calibration(calibration), path, track.image_size, undistorted=True)
+    return np.asarray(camera.R, dtype=float)[2]
 
 
 def notate(
@@ -453,6 +468,7 @@ def notate(
     camera=(None, ""),
     extra_outputs=None,
     workers: int = 1,
+    line_of_sight=None,
 ) -> CaptureResult:
     """Quantise fitted joints and write every output of a capture (after :func:`load_motion`).
 
@@ -471,6 +487,9 @@ def notate(
     extra_outputs : callable, optional
         ``extra_outputs(stage) -> dict`` of further files written into the
         staging folder (a multi-view capture's overlays).
+    line_of_sight : (3,) ndarray, optional
+        A single camera's viewing axis in the fit's world (symbol
+        confidence: depth is measured worst along it); None otherwise.
     Other parameters are :func:`capture`'s.
     """
     outdir = Path(outdir)
@@ -506,7 +525,7 @@ def notate(
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
     conf = getattr(motion, "confidence", None)
-    seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf))
+    seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf, line_of_sight=line_of_sight))
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
     log.info("capture: tempo %s bpm%s", seg.tempo, how)

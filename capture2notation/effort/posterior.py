@@ -169,10 +169,12 @@ _RHO_GRID = np.linspace(RHO_RANGE[0] + 0.005, RHO_RANGE[1] - 0.005, 40)
 
 def _rho_starts(batch: Batch, starts: np.ndarray) -> np.ndarray:
     """(G, 3) starts: each (b, x0) with the ρ of highest marginal density given it, from a grid."""
-    k = _RHO_GRID.size
-    theta = np.column_stack([np.repeat(starts, k, axis=0), np.tile(_RHO_GRID, len(starts))])
+    lo, hi = batch.rho_range
+    grid = np.linspace(lo + 0.005, hi - 0.005, _RHO_GRID.size)
+    k = grid.size
+    theta = np.column_stack([np.repeat(starts, k, axis=0), np.tile(grid, len(starts))])
     lp = batch.log_marginal(theta).reshape(len(starts), k)
-    best = _RHO_GRID[np.argmax(np.where(np.isfinite(lp), lp, -np.inf), axis=1)]
+    best = grid[np.argmax(np.where(np.isfinite(lp), lp, -np.inf), axis=1)]
     return np.column_stack([starts, best])
 
 
@@ -185,6 +187,7 @@ def sample_posteriors(
     max_steps: int = 6000,
     tau_rtol: float = 0.05,
     ar1: bool = True,
+    rho_range=RHO_RANGE,
 ) -> list:
     """Sample many independent posteriors of (b, x0, ln σ) together.
 
@@ -213,6 +216,9 @@ def sample_posteriors(
     ar1 : bool
         AR(1) residuals along each movement with their correlation ρ
         marginalised (default); False: independent residuals.
+    rho_range : (2,) tuple of float
+        Uniform prior bounds of ρ: :data:`RHO_RANGE` (default), or
+        :data:`~.likelihood.CAPTURE_RHO_RANGE` for a fitted capture.
 
     Returns
     -------
@@ -224,7 +230,7 @@ def sample_posteriors(
     datasets = list(datasets)
     if not datasets:
         return []
-    batch = Batch(datasets, free_ends=free_ends, ar1=ar1)
+    batch = Batch(datasets, free_ends=free_ends, ar1=ar1, rho_range=rho_range)
     fits = fit_logistic_many([batch.dataset(g) for g in range(batch.n_groups)])
     starts, balls, start3 = [], [], []
     for fit in fits:

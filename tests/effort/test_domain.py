@@ -117,3 +117,20 @@ def test_a_leg_phrase_is_not_read_and_says_why():
 def test_no_pooled_effort_is_outside():
     dom = emotion_domain(Score(tempo=F(60)), [], np.zeros((10, len(JOINTS), 3)), None, JOINTS)
     assert not dom.inside and "no pooled Effort" in "; ".join(dom.reasons)
+
+
+@pytest.mark.parametrize(
+    ("seed", "travel"),
+    [(1601, False), (1602, False), (1603, True)],
+)
+def test_random_scores_outside_the_port_de_bras_are_not_read(seed, travel):
+    """Tai chi-like random phrases (arms, legs and chest at 40 bpm with a random Effort) and a random
+    walk are not what the presets describe: no emotion, and a reason."""
+    from synthetic.random_scores import random_score
+
+    rng = np.random.default_rng(seed)
+    parts = ("right_arm", "left_arm", "chest", "legs")
+    score = random_score(rng, n_beats=8, parts=parts, tempo=F(40), random_effort=True, travel=travel, fps=FPS)
+    res = estimate_effort(interpret(score, fps=FPS).joints(), None, FPS, score, rng=seed, per_movement=False)
+    assert res.emotion is None and not res.domain.inside
+    assert res.to_dict()["emotion_text"].startswith("not read: ")

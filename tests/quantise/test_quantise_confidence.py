@@ -1,13 +1,25 @@
-"""Symbol confidence from the fit's confidence and the angle's margin to a boundary."""
+"""Symbol confidence: the fit's confidence times the probability that the true direction lies in the symbol's cell.
+
+Reference values are computed here from the module's stated error model
+(normal interval probabilities with scipy.stats.norm), not from its output.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.stats import norm
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.notation import Score, Symbol
-from capture2notation.quantise.confidence import MARGIN_FULL_DEG, score_confidence, symbol_margin_deg
+from capture2notation.quantise.confidence import (
+    ANGLE_SD_DEG,
+    DEPTH_SD_DEG,
+    FRAME_YAW_SD_DEG,
+    direction_probability,
+    score_confidence,
+    symbol_margin_deg,
+)
 
 
 def _unit(az_deg, el_deg):
@@ -38,17 +50,65 @@ def _score():
     return Score.from_symbols([Symbol(0, 1, "right_arm", "forward", "low")], tempo=60)
 
 
-def test_a_limb_in_mid_sector_with_a_confident_fit_is_certain():
+def _p(x, lo, hi, sd):
+    return norm.cdf((hi - x) / sd) - norm.cdf((lo - x) / sd)
+
+
+def _p_forward_low(el_deg: float) -> float:
+    """The stated model's probability for a still arm at azimuth 0, elevation `el_deg`, isotropic error
+    (no camera: no yaw error of a single view's body frame)."""
+    sd_az = ANGLE_SD_DEG / np.cos(np.radians(el_deg))
+    return _p(el_deg, -67.5, -22.5, ANGLE_SD_DEG) * _p(0.0, -22.5, 22.5, sd_az)
+
+
+def test_a_limb_in_mid_sector_with_a_confident_fit_is_likely_right():
     joints = _held_arm(45.0)  # forward low: elevation -45, the level's centre
     s = score_confidence(_score(), joints, 25.0).symbols[0]
-    assert s.confidence == pytest.approx(1.0)
+    assert s.confidence == pytest.approx(_p_forward_low(-45.0), abs=0.002)
+    assert not s.uncertain
 
 
-def test_a_limb_near_a_level_boundary_is_uncertain():
-    joints = _held_arm(90.0 - 22.5 - 2.0)  # elevation -20.5: 2 degrees from middle
+def test_a_limb_just_inside_a_level_boundary_is_less_sure():
+    joints = _held_arm(90.0 - 22.5 - 2.0)  # elevation -24.5: 2 degrees inside low
     s = score_confidence(_score(), joints, 25.0).symbols[0]
-    assert s.confidence == pytest.approx(2.0 / MARGIN_FULL_DEG, abs=0.02)
+    assert s.confidence == pytest.approx(_p_forward_low(-24.5), abs=0.002)
+    assert s.confidence < score_confidence(_score(), _held_arm(45.0), 25.0).symbols[0].confidence
+
+
+def test_a_limb_outside_the_symbols_cell_is_uncertain():
+    joints = _held_arm(90.0 - 22.5 + 3.0)  # elevation -19.5: the middle level, not low
+    s = score_confidence(_score(), joints, 25.0).symbols[0]
+    assert s.confidence == pytest.approx(_p_forward_low(-19.5), abs=0.002)
     assert s.uncertain
+
+
+def test_depth_along_the_line_of_sight_is_less_certain():
+    # The forward-low arm points half along a camera on +y: its elevation error mixes in the depth error.
+    joints = _held_arm(45.0)
+    s = score_confidence(_score(), joints, 25.0, line_of_sight=np.array([0.0, 1.0, 0.0])).symbols[0]
+    sd_el = np.sqrt(ANGLE_SD_DEG**2 + (DEPTH_SD_DEG**2 - ANGLE_SD_DEG**2) * 0.5)
+    sd_az = np.hypot(ANGLE_SD_DEG / np.cos(np.radians(45.0)), FRAME_YAW_SD_DEG)  # azimuth tangent is across
+    expect = _p(-45.0, -67.5, -22.5, sd_el) * _p(0.0, -22.5, 22.5, sd_az)
+    assert s.confidence == pytest.approx(expect, abs=0.002)
+    assert s.confidence < _p_forward_low(-45.0)
+
+
+def test_direction_probability_at_a_boundary_is_half_the_other_factor():
+    held = _unit(22.5, 0.0)  # on the forward / right_forward boundary, middle level
+    p = direction_probability(held, "forward", "middle")
+    sd_az = ANGLE_SD_DEG
+    assert p == pytest.approx(_p(0.0, -22.5, 22.5, ANGLE_SD_DEG) * _p(22.5, -22.5, 22.5, sd_az), abs=1e-6)
+    assert direction_probability(held, "forward", "middle") == pytest.approx(
+        direction_probability(held, "right_forward", "middle"), abs=1e-6
+    )
+    assert direction_probability(np.full((3, 3), np.nan), "forward", "middle") == 0.0
+
+
+def test_jitter_over_the_hold_widens_the_error():
+    rng = np.random.default_rng(16)
+    steady = np.repeat(_unit(15.0, 0.0), 6, axis=0)
+    shaky = steady + 0.15 * rng.standard_normal(steady.shape)
+    assert direction_probability(shaky, "forward", "middle") < direction_probability(steady, "forward", "middle")
 
 
 def test_the_fits_confidence_lowers_it():
@@ -56,7 +116,7 @@ def test_the_fits_confidence_lowers_it():
     conf = np.ones(joints.shape[:2])
     conf[:, joint_index("right_wrist")] = 0.3
     s = score_confidence(_score(), joints, 25.0, conf).symbols[0]
-    assert s.confidence == pytest.approx(0.3)
+    assert s.confidence == pytest.approx(0.3 * _p_forward_low(-45.0), abs=0.002)
     missing = joints.copy()
     missing[:, joint_index("right_wrist")] = np.nan
     assert score_confidence(_score(), missing, 25.0).symbols[0].confidence == 0.0
