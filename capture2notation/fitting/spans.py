@@ -48,7 +48,7 @@ def track_spans(n_frames: int, fps: float, span_s: float = SPAN_S, context_s: fl
     fps : float
         Frames per second.
     span_s, context_s : float
-        Seconds per span, and of context on each side (>= 0).
+        Seconds per span (``inf``: one span), and of context on each side (>= 0).
 
     Returns
     -------
@@ -64,15 +64,15 @@ def track_spans(n_frames: int, fps: float, span_s: float = SPAN_S, context_s: fl
     """
     if not (np.isfinite(fps) and fps > 0):
         raise FittingError(f"fps must be a positive number, got {fps!r}")
-    if not (np.isfinite(span_s) and span_s > 0):
+    if not span_s > 0:  # NaN too; inf: never split
         raise FittingError(f"span_s must be > 0 seconds, got {span_s!r}")
     if not (np.isfinite(context_s) and context_s >= 0):
         raise FittingError(f"context_s must be >= 0 seconds, got {context_s!r}")
     n = int(n_frames)
-    span = max(1, int(round(span_s * fps)))
     context = int(round(context_s * fps))
-    if n <= span + 2 * context:
+    if np.isinf(span_s) or n <= span_s * fps + 2 * context:
         return [(0, n, 0, n)]
+    span = max(1, int(round(span_s * fps)))
     n_spans = -(-n // span)
     edges = np.linspace(0, n, n_spans + 1).round().astype(int)
     return [(max(a - context, 0), min(b + context, n), int(a), int(b)) for a, b in itertools.pairwise(edges.tolist())]

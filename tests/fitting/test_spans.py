@@ -40,6 +40,7 @@ def test_kept_frames_tile_the_clip_and_each_span_holds_its_context(n, fps, span_
 def test_a_clip_no_longer_than_a_span_is_one_span():
     assert track_spans(1600, 25.0, 60.0, 2.0) == [(0, 1600, 0, 1600)]
     assert len(track_spans(1601, 25.0, 60.0, 2.0)) == 2
+    assert track_spans(10**6, 25.0, np.inf, 2.0) == [(0, 10**6, 0, 10**6)]
 
 
 @pytest.mark.parametrize(
