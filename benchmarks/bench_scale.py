@@ -23,9 +23,9 @@ Three measurements (each prints its table; nothing is asserted):
 
 ``--spans``
     The fit of each held-out phrase (``benchmarks/holdout``, measured only)
-    through BlazePose whole and in 5-s spans, quantised with the tempo
+    through BlazePose whole and in 2-s spans, quantised with the tempo
     given: cells that differ between the two (the capture fits in 60-s
-    spans; short spans make every phrase several).
+    spans; 2-s spans make every phrase several).
 
 Run: ``python benchmarks/bench_scale.py --video 60 --minutes 2 4 8 --spans``.
 """
@@ -48,6 +48,8 @@ import numpy as np
 
 HOLDOUT = Path(__file__).resolve().parent / "holdout"
 TEMPO = 90
+#: Span of --spans, seconds: with 2 s of context each side, every held-out phrase is several spans.
+SHORT_SPAN_S = 2.0
 #: A pose model's errors on the synthetic track: pixels, and metres on the world landmarks.
 PIXEL_NOISE, WORLD_NOISE = 3.0, 0.02
 
@@ -180,12 +182,13 @@ def bench_spans(workdir: Path) -> None:
     from capture2notation.fitting import fit_track
     from capture2notation.fitting.depth import DepthOptions
     from capture2notation.fitting.solver import FitOptions
+    from capture2notation.fitting.spans import track_spans
     from capture2notation.keypoints import extract
     from capture2notation.notation.formats import read
     from capture2notation.quantise.segment import segment_motion
     from synthetic.render import render_score
 
-    print("\n## Held-out phrases fitted whole and in 5-s spans (BlazePose, tempo given)\n")
+    print("\n## Held-out phrases fitted whole and in 2-s spans (BlazePose, tempo given)\n")
     print("| phrase | frames | spans | matched | unmatched | symbol agreement |")
     print("|---|---|---|---|---|---|")
     opt = FitOptions(depth=DepthOptions(rest_offset=True))
@@ -194,13 +197,13 @@ def bench_spans(workdir: Path) -> None:
         render = render_score(score, workdir / "spans" / path.stem, progress=False)
         track = extract(render / "video.mp4", progress=False)
         scores = []
-        for span in (np.inf, 5.0):
+        for span in (np.inf, SHORT_SPAN_S):
             motion = fit_track(track, options=dataclasses.replace(opt, span_s=span))
             scores.append(segment_motion(np.asarray(motion.joints), motion.fps, tempo=score.tempo).score)
         agree = compare_scores(scores[0], scores[1])
         n = len(track)
         print(
-            f"| {path.stem} | {n} | {-(-n // 125)} | {agree.matched} | {agree.unmatched} "
+            f"| {path.stem} | {n} | {len(track_spans(n, track.fps, SHORT_SPAN_S))} | {agree.matched} | {agree.unmatched} "
             f"| {agree.symbol_agreement:.3f} |"
         )
 
