@@ -7,8 +7,11 @@ with the given seeds, or ``benchmarks/holdout/*.lab`` with ``--holdout``: for
 the final figure only, never for tuning) is rendered once per view at 25 fps,
 640×480, mannequin (the motion is deterministic for a score, so the renders
 are one performance seen by several cameras); the renders' ``camera.toml``
-files are merged into one calibration given explicitly (until ``c2n
-calibrate`` lands); then ``capture([clips], calibration=...)`` with BlazePose and the tempo given.
+files are merged into one calibration given explicitly, or ``--calibration
+FILE`` (from ``c2n calibrate`` on the board clips of ``c2n render --views
+... --calibration-clip``: the renderer's preset cameras are the same for
+every score, so one calibration serves all); then ``capture([clips],
+calibration=...)`` with BlazePose and the tempo given.
 The truth sidecar is read only to score the capture afterwards.
 
 The first view alone (its camera given likewise) is captured too, for
@@ -41,8 +44,11 @@ def merged_calibration(renders: dict, path: Path) -> Path:
     return write_calibration(Calibration.of(cams), path, comment="the renders' true cameras, merged")
 
 
-def measure(score, workdir: Path, views: list[str]) -> dict:
-    """Render `score` once per view, capture from all views, compare with the score and the truth."""
+def measure(score, workdir: Path, views: list[str], calibration: Path | None = None) -> dict:
+    """Render `score` once per view, capture from all views, compare with the score and the truth.
+
+    `calibration` replaces the renders' true cameras (merged) when given.
+    """
     from capture2notation.compare.agreement import compare_scores
     from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
@@ -54,7 +60,7 @@ def measure(score, workdir: Path, views: list[str]) -> dict:
         renders[v] = render_score(
             score, workdir / v, fps=25.0, size=(640, 480), view=v, style="mannequin", progress=False
         )
-    cal = merged_calibration(renders, workdir / "cameras.toml")
+    cal = calibration or merged_calibration(renders, workdir / "cameras.toml")
     t0 = time.perf_counter()
     from pipelines.capture import capture
 
@@ -98,6 +104,9 @@ def main() -> None:
     ap.add_argument("--seeds", default="101,102", help="Seeds of the random scores.")
     ap.add_argument("--holdout", action="store_true", help="The holdout phrases (final figure only).")
     ap.add_argument("--beats", type=int, default=8, help="Beats per random score.")
+    ap.add_argument(
+        "--calibration", type=Path, default=None, help="Cameras from c2n calibrate (default: the true ones)."
+    )
     args = ap.parse_args()
     views = [v.strip() for v in args.views.split(",")]
     if args.holdout:
@@ -110,7 +119,7 @@ def main() -> None:
     rows = []
     for name, score in items:
         with tempfile.TemporaryDirectory() as tmp:
-            r = measure(score, Path(tmp), views)
+            r = measure(score, Path(tmp), views, args.calibration)
         rows.append(r)
         print(
             f"{name:<22} agreement {100 * r['agreement']:5.1f} %  limb {r['limb_deg']:4.1f}°  "
@@ -119,7 +128,8 @@ def main() -> None:
             f"limb {r['one_limb_deg']:4.1f}°  MPJPE {r['one_mpjpe_cm']:4.1f} cm",
             flush=True,
         )
-    print(f"views {'+'.join(views)}, BlazePose, 640x480, 25 fps, cameras given, tempo given:")
+    cams = f"cameras from {args.calibration}" if args.calibration else "cameras given"
+    print(f"views {'+'.join(views)}, BlazePose, 640x480, 25 fps, {cams}, tempo given:")
     print(f"  symbol agreement (mean)        {100 * np.mean([r['agreement'] for r in rows]):.1f} %  (target >= 97 %)")
     print(f"  median limb-direction error    {np.median([r['limb_deg'] for r in rows]):.1f}°  (target <= 3°)")
     print(f"  MPJPE (mean)                   {np.mean([r['mpjpe_cm'] for r in rows]):.1f} cm  (target <= 3 cm)")

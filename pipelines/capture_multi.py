@@ -309,7 +309,10 @@ def load_views(
     seconds["triangulate"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     times = np.asarray(tracks[0].times)[spans[0]]
-    motion = fit_points3d(joints, jconf, fps, times=times - times[0], virtual=virtual)
+    # The floor is now z = 0: the fit holds the lowest foot there, as the
+    # one-view fit does through a known camera (triangulated feet jitter by
+    # centimetres, about the quantiser's 3-cm support threshold).
+    motion = fit_points3d(joints, jconf, fps, times=times - times[0], virtual=virtual, floor=True)
     seconds["fitting"] = time.perf_counter() - t0
     names = [camera_name(v) for v in videos]
 

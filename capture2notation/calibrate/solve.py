@@ -51,6 +51,9 @@ MIN_VIEWS = 4
 #: degrees; a single view's pose scatters by millimetres and tenths of a
 #: degree) belong to the board still on the floor, fitted as one pose.
 STILL_M, STILL_DEG = 0.01, 1.0
+#: Largest difference between two clips' frame rates taken as equal, fps
+#: (containers round 25 to 25.0000x).
+FPS_TOL = 0.01
 #: Largest acceptable reprojection RMS, pixels: a sound ChArUco calibration is
 #: well under one pixel; several pixels mean a wrong board, unsynchronised
 #: clips or a moving camera.
@@ -227,13 +230,20 @@ def calibrate_cameras(
     Raises
     ------
     CalibrationError
-        Fewer than two cameras, a camera that never sees the board together
-        with the others, too few views, or a fit above :data:`MAX_RMS_PX`.
+        Fewer than two cameras, clips of different frame rates, a camera that
+        never sees the board together with the others, too few views, or a
+        fit above :data:`MAX_RMS_PX`.
     """
     if len(detections) < 2:
         raise CalibrationError(f"calibration needs two or more clips, got {len(detections)}")
     if len(set(names)) != len(names):
         raise CalibrationError(f"two clips have the same camera name: {', '.join(names)}")
+    for d in detections[1:]:
+        if abs(d.fps - detections[0].fps) > FPS_TOL:
+            raise CalibrationError(
+                f"{d.source}: frame rate {d.fps:g} fps differs from {detections[0].source}'s "
+                f"{detections[0].fps:g} fps; the calibration pairs the clips frame by frame (film at one rate)"
+            )
     obj = object_points(board)
     intr = np.array([_intrinsics(d, obj) for d in detections])
     poses = [_poses(d, obj, i) for d, i in zip(detections, intr)]

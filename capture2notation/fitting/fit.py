@@ -32,7 +32,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..body import JOINTS, Body, joint_index
+from ..body import JOINTS, Body
 from ..errors import FittingError, MotionFileError
 from .camera import DEFAULT_HFOV_DEG, Camera
 from .depth import DepthOptions, choose_arm_depths, remove_leg_rest_offsets
@@ -40,9 +40,11 @@ from .ground import fit_floor, level_points
 from .model import PoseModel
 from .result import FitResult
 from .solver import (
+    FOOT_POINTS,
     FitOptions,
     Terms,
     check_fps,
+    floor_terms,
     rewarm,
     solve,
     to_result,
@@ -386,25 +388,12 @@ def _prepared(xy, conf, world, image_z, fps, body, camera, known, offsets, opt, 
     return model, terms, names, tx, tc, use2, params0
 
 
-#: Model points that can touch the floor.
-_FOOT_POINTS = ("right_toe", "left_toe", "right_heel", "left_heel", "right_ankle", "left_ankle")
-
-
 def _floor_terms(model: PoseModel, terms: Terms, tc: np.ndarray, names) -> None:
     """Add the floor-contact term to `terms` (known camera: the floor is z = 0).
 
-    A point's target is its height when standing flat on both feet, so flat
-    feet, relevé (toes) and plié all satisfy it.  Frames whose feet are not
-    seen get no floor term.
+    Frames whose feet are not seen get no floor term (:func:`~.solver.floor_terms`).
     """
-    idx = np.array([model.index(n) for n in _FOOT_POINTS])
-    rest = model.forward(np.zeros((1, model.n_params)))[0]
-    body = model.body
-    lowest_rest = body.rest[[joint_index("right_toe"), joint_index("right_ankle")], 2].min()
-    terms.floor_idx = idx
-    terms.floor_z = rest[idx, 2] - rest[idx, 2].min() + lowest_rest
-    seen = tc[:, [names.index(n) for n in _FOOT_POINTS]].max(axis=1)
-    terms.floor_w = np.where(seen >= 0.5, 1.0, 0.0)
+    floor_terms(model, terms, tc[:, [names.index(n) for n in FOOT_POINTS]].max(axis=1))
 
 
 def _joint_confidence(names, tconf) -> np.ndarray:

@@ -15,7 +15,7 @@ from .ik import initial_angles
 from .lengths import estimate_offsets
 from .model import PoseModel
 from .result import FitResult
-from .solver import FitOptions, Terms, check_fps, fill2, rewarm, solve, to_result
+from .solver import FOOT_POINTS, FitOptions, Terms, check_fps, fill2, floor_terms, rewarm, solve, to_result
 
 __all__ = ["fit_points3d"]
 
@@ -30,6 +30,7 @@ def fit_points3d(
     times=None,
     virtual: dict[str, np.ndarray] | None = None,
     options: FitOptions | None = None,
+    floor: bool = False,
 ) -> FitResult:
     """Fit joint angles to measured 3D joint positions (mocap, Kinect).
 
@@ -48,6 +49,12 @@ def fit_points3d(
         Extra measured points by model virtual-point name (e.g.
         ``"head_centre"``) -> ``((T, 3) positions, (T,) confidence)``.
     options : FitOptions, optional
+    floor : bool
+        The floor is known to be z = 0 (calibrated cameras, the floor found
+        from the feet): the fit's lowest foot point is held at its standing
+        height with :attr:`FitOptions.sigma_floor` (Huber: jumps go), as the
+        one-view fit's is through a known camera.  Triangulated feet scatter
+        by centimetres; a support is judged against the floor by less.
 
     Returns
     -------
@@ -89,6 +96,9 @@ def fit_points3d(
         dirs.append(np.where(ok[:, None], d / np.where(ok[:, None], ln, 1.0), np.nan))
         wd.append(np.where(ok, np.minimum(conf[:, j], conf[:, p]), 0.0))
     terms.pairs, terms.dirs, terms.wd = np.array(pairs), np.stack(dirs, 1), np.stack(wd, 1)
+    if floor and opt.sigma_floor > 0:
+        feet = [JOINTS.index(n) for n in FOOT_POINTS if n in JOINTS]
+        floor_terms(model, terms, conf[:, feet].max(axis=1))
     params0 = np.zeros((points.shape[0], model.n_params))
     pel = points[:, 0]
     params0[:, :3] = fill2(pel, fallback=body.rest[0])

@@ -174,6 +174,36 @@ class Terms:
     floor_w: np.ndarray | None = None  # (T,)
 
 
+#: Model points that can touch the floor.
+FOOT_POINTS = ("right_toe", "left_toe", "right_heel", "left_heel", "right_ankle", "left_ankle")
+#: Confidence of the best-seen foot point from which a frame gets the floor term.
+FLOOR_SEEN = 0.5
+
+
+def floor_terms(model: PoseModel, terms: Terms, seen: np.ndarray) -> None:
+    """Set the floor-contact term of `terms`: some foot stands on the floor z = 0.
+
+    A point's target is its height when standing flat on both feet, so flat
+    feet, relevé (toes) and plié all satisfy it.
+
+    Parameters
+    ----------
+    model : PoseModel
+    terms : Terms
+        Modified in place (``floor_idx``, ``floor_z``, ``floor_w``).
+    seen : (T,) ndarray
+        Confidence of the best-seen foot point per frame; frames under
+        :data:`FLOOR_SEEN` get no floor term.
+    """
+    idx = np.array([model.index(n) for n in FOOT_POINTS])
+    rest = model.forward(np.zeros((1, model.n_params)))[0]
+    body = model.body
+    lowest_rest = body.rest[[JOINTS.index("right_toe"), JOINTS.index("right_ankle")], 2].min()
+    terms.floor_idx = idx
+    terms.floor_z = rest[idx, 2] - rest[idx, 2].min() + lowest_rest
+    terms.floor_w = np.where(np.asarray(seen) >= FLOOR_SEEN, 1.0, 0.0)
+
+
 def _normal_equations(model: PoseModel, params, terms: Terms, opt: FitOptions, need_jac: bool):
     """Per-frame cost, and (if asked) Gauss-Newton ``H = JᵀWJ`` and ``g = JᵀWr``."""
     T, n = params.shape

@@ -164,8 +164,9 @@ SIDE_GROUPS: dict[str, tuple[tuple[int, int], ...]] = {
 SIDE_MEDIAN_FRAMES = 5
 
 
-def _group_error(uv, vis, cameras) -> np.ndarray:
-    """Mean reprojection error (T,) of points triangulated from `uv` (V, T, n, 2); large where none."""
+def _group_error(uv, vis, cameras) -> tuple[np.ndarray, np.ndarray]:
+    """Mean reprojection error (T,) of points triangulated from `uv` (V, T, n, 2), large where none,
+    and the vector (T, 3) from the first point to the second (NaN where either is missing)."""
     P, _, used = triangulate(uv, vis, cameras)
     err = np.zeros(P.shape[:2])
     n = np.zeros(P.shape[:2])
@@ -174,7 +175,33 @@ def _group_error(uv, vis, cameras) -> np.ndarray:
         ok = used[v] & np.isfinite(e)
         err += np.where(ok, e, 0.0)
         n += ok
-    return np.where(n.sum(axis=1) > 0, err.sum(axis=1) / np.maximum(n.sum(axis=1), 1), 1e6)
+    mean = np.where(n.sum(axis=1) > 0, err.sum(axis=1) / np.maximum(n.sum(axis=1), 1), 1e6)
+    return mean, P[:, 1] - P[:, 0]
+
+
+#: Largest angle, degrees, seen from above, between the hips' left → right
+#: line and the shoulders': the trunk twists by 40-50° at most.  Two
+#: cameras placed symmetrically about the performer (45° and −45°) see a
+#: front-facing stance almost mirror-symmetric, and the swapped legs' rays
+#: meet too (reprojecting as well as the true ones) but with the hips turned
+#: by 90°, one in front of the other; this catches that labelling.
+MAX_TWIST_DEG = 60.0
+
+
+def _horizontal_cos(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cosine (T,) of the angle between vectors (T, 3) seen from above (NaN where undefined)."""
+    a, b = a[:, :2], b[:, :2]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.sum(a * b, axis=1) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+
+
+def _swap_frames(keep: np.ndarray, swap: np.ndarray) -> np.ndarray:
+    """Frames (T,) of bool where the swapped labels reproject better, over a running median.
+
+    A limb's label does not flicker: the median of the error difference over
+    :data:`SIDE_MEDIAN_FRAMES` frames decides.
+    """
+    return median_filter(swap - keep, size=SIDE_MEDIAN_FRAMES, mode="nearest") < 0
 
 
 def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -184,7 +211,11 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     (or arms) as a whole; triangulating a swapped view against a right one
     puts both limbs between them.  For each view after the first, each
     group of :data:`SIDE_GROUPS` and each frame, the labelling whose
-    two-view triangulation with the first view reprojects closer is kept.
+    two-view triangulation with the first view reprojects closer is kept;
+    for the legs, only among labellings whose hips (the group's first pair)
+    turn with the shoulders (the arms' first pair, decided first) within
+    :data:`MAX_TWIST_DEG` seen from above: two cameras placed symmetrically
+    about a front-facing dancer cannot tell swapped legs by reprojection.
 
     Parameters
     ----------
@@ -207,14 +238,20 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
         for g, pairs in enumerate(SIDE_GROUPS.values()):
             idx = np.array([i for ab in pairs for i in ab])
             alt = np.array([i for a, b in pairs for i in (b, a)])
-            keep = _group_error(
+            keep, v_keep = _group_error(
                 np.stack([uv[0][:, idx], uv[v][:, idx]]), np.stack([vis[0][:, idx], vis[v][:, idx]]), pair
             )
-            swap = _group_error(
+            swap, v_swap = _group_error(
                 np.stack([uv[0][:, idx], uv[v][:, alt]]), np.stack([vis[0][:, idx], vis[v][:, alt]]), pair
             )
-            # A running median over a few frames: a limb's label does not flicker.
-            frames = median_filter(swap - keep, size=SIDE_MEDIAN_FRAMES, mode="nearest") < 0
+            if g == 0:
+                shoulders = np.where(_swap_frames(keep, swap)[:, None], v_swap, v_keep)
+            else:
+                # The hips turn with the shoulders (the arms group, decided first).
+                limit = np.cos(np.radians(MAX_TWIST_DEG))
+                keep = np.where(_horizontal_cos(v_keep, shoulders) < limit, 1e6, keep)
+                swap = np.where(_horizontal_cos(v_swap, shoulders) < limit, 1e6, swap)
+            frames = _swap_frames(keep, swap)
             uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
             vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
             swapped[v, :, g] = frames

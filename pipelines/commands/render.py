@@ -82,7 +82,7 @@ def _phone_camera(view, size, camera_height, pitch, roll, hfov):
 )
 @click.option("--fps", type=FPS, default=25.0, show_default=True, help="Frames per second.")
 @click.option("--size", default="640x480", show_default=True, help="Image WIDTHxHEIGHT in pixels.")
-@click.option("--view", default="front", show_default=True, help="Camera: front, 45 or side.")
+@click.option("--view", default="front", show_default=True, help="Camera: front, 45, side or -45.")
 @click.option("--style", default="mannequin", show_default=True, help="Drawing: mannequin, stick or markers.")
 @click.option("--emotion", default=None, help="Perform with an emotion preset: happy, sad, angry or afraid.")
 @click.option("--png", is_flag=True, help="Write the frames as OUTDIR/frames/frame_NNNNNN.png instead of video.mp4.")

@@ -19,8 +19,9 @@ __all__ = ["VIEWS", "Camera", "look_at_rotation"]
 
 #: Named viewpoints: azimuth of the camera around the performer, degrees
 #: clockwise seen from above, from the performer's front (+y) towards their
-#: right (+x).
-VIEWS: dict[str, float] = {"front": 0.0, "45": 45.0, "side": 90.0}
+#: right (+x); ``-45`` is half-way round towards their left (the 45° / −45°
+#: camera pair of a two-camera capture).
+VIEWS: dict[str, float] = {"front": 0.0, "45": 45.0, "side": 90.0, "-45": -45.0}
 
 # Extent of the space a performance may fill, as fractions of body height,
 # relative to the starting pelvis: arms overhead reach 1.26 H above the floor,
@@ -146,10 +147,10 @@ class Camera:
 
         Parameters
         ----------
-        view : {"front", "45", "side"}
+        view : {"front", "45", "side", "-45"}
             ``front``: on +y looking back at the performer; ``45``: half-way
             round towards the performer's right; ``side``: from the
-            performer's right (+x).
+            performer's right (+x); ``-45``: half-way round towards their left.
         size : (int, int)
             Image (width, height), pixels.
         body_height : float
@@ -197,7 +198,7 @@ class Camera:
 
         Parameters
         ----------
-        view : {"front", "45", "side"}
+        view : {"front", "45", "side", "-45"}
         size : (int, int)
             Image (width, height), pixels.
         body_height : float

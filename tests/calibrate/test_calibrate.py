@@ -34,10 +34,10 @@ def _angle_deg(Ra, Rb) -> float:
 
 @pytest.fixture(scope="module")
 def scene():
-    """Two cameras' detections of the board: 8 frames on the floor, then one frame per pose."""
+    """Two cameras' detections of the board: 8 frames on the floor, then one frame per pose (16 poses, for speed)."""
     cams = [Camera.for_view(v, (640, 480)) for v in VIEWS]
     rng = np.random.default_rng(3)
-    path = board_path(cams, rng)
+    path = board_path(cams, rng, n_poses=16)
     image = _BoardImage(BOARD)
     poses = [(path.R[0], path.p[0])] * 8 + list(zip(path.R[1:], path.p[1:]))
     dets = []
@@ -103,3 +103,10 @@ def test_one_camera_or_repeated_names_are_refused(scene):
         calibrate_cameras([a], ["front"], BOARD)
     with pytest.raises(CalibrationError, match="same camera name"):
         calibrate_cameras([a, b], ["front", "front"], BOARD)
+
+
+def test_clips_of_different_frame_rates_are_refused(scene):
+    cams, (a, b) = scene
+    slow = BoardDetections(b.source, b.image_size, 12.5, b.n_frames, b.frames, b.ids, b.corners)
+    with pytest.raises(CalibrationError, match=r"45\.mp4: frame rate 12\.5 fps differs from front\.mp4's 25 fps"):
+        _calibrate(cams, [a, slow])

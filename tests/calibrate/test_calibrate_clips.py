@@ -52,11 +52,6 @@ def test_rendered_clips_calibrate_to_rms_and_orientation_targets(calibrated):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="centres 1.3 cm off (docs/benchmarks/calibration.md): focal lengths 0.3 % long put the "
-    "cameras, 3.8 m away, that much too far from the board that fixes the world",
-)
 def test_rendered_clips_calibrate_to_the_centre_target(calibrated):
     truth, est = calibrated
     for name in truth.names:
