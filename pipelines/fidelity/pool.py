@@ -182,8 +182,13 @@ def _execute_local(fn, items, on_done, workers, on_progress) -> None:
 
 
 def _execute_dask(fn, items, on_done, scheduler, timeout, on_progress) -> None:
-    from dask.distributed import Client
-    from dask.distributed import as_completed as dask_completed
+    try:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+    except ImportError:
+        raise PipelineError(
+            f"--scheduler {scheduler}: a Dask scheduler needs dask.distributed: pip install 'capture2notation[cluster]'"
+        ) from None
 
     try:
         client = Client(scheduler, timeout=f"{timeout}s")

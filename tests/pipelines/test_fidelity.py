@@ -177,3 +177,12 @@ def test_conclusions_judge_the_observer_against_the_experts_with_a_binomial_test
     text = " ".join(conclusions(table, {}))
     assert "Viewpoint: sufficient — front, 45. Not sufficient — side (symbols 90%, observer 62 %)" in text
     assert "Pixel noise: sufficient — noise=0. Not sufficient — noise=5" in text
+
+
+def test_a_scheduler_without_dask_says_which_extra(tmp_path, tiny_study, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # import fails as if not installed
+    cfg = StudyConfig(**tiny_study)
+    with pytest.raises(PipelineError, match=r"capture2notation\[cluster\]"):
+        run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False, connect_timeout=2)
