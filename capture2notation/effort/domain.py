@@ -19,6 +19,7 @@ fails: an emotion is read only from a phrase known to be a port de bras.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -172,7 +173,8 @@ def _spread(x: np.ndarray) -> float:
 
 def _body_height(joints: np.ndarray) -> float:
     """The performer's standing extent, metres: 95th percentile over frames of the joints' vertical span."""
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # frames with no joint: NaN, dropped below
         span = np.nanmax(joints[:, :, 2], axis=1) - np.nanmin(joints[:, :, 2], axis=1)
     span = span[np.isfinite(span)]
     return float(np.percentile(span, 95)) if span.size else float("nan")

@@ -51,6 +51,7 @@ Whole limb or segments
 
 from __future__ import annotations
 
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -583,6 +584,13 @@ def _same_pose(pose: tuple, last: tuple | None, state: tuple, params: SegmentPar
     return not (np.isfinite(bend) and np.isfinite(last[1]) and abs(bend - last[1]) >= BEND_STEP_DEG / 2)
 
 
+def _hold_mean(values: np.ndarray):
+    """Mean over a hold's frames (axis 0), NaN where none was measured (no warning: a hold may be unseen)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(values, axis=0)
+
+
 def _progress_window(u_list: list, x_list: list, spans: list, i: int, fps: float):
     """``(t, p, t0, t1)`` of span `i` for :func:`~.timing.refine_times`, or None.
 
@@ -601,13 +609,13 @@ def _progress_window(u_list: list, x_list: list, spans: list, i: int, fps: float
     post = slice(min(hi, (b + 1 + hi + 1) // 2), hi + 1)
     best, weight = None, 0.0
     for u in u_list:
-        p0, p1 = np.nanmean(u[pre], axis=0), np.nanmean(u[post], axis=0)
+        p0, p1 = _hold_mean(u[pre]), _hold_mean(u[post])
         p0, p1 = p0 / np.linalg.norm(p0), p1 / np.linalg.norm(p1)
         amp = float(_angle_deg(p0, p1))
         if np.isfinite(amp) and amp > weight:
             best, weight = progress_signal(u[lo : hi + 1], p0, p1), amp
     for x in x_list:
-        x0, x1 = np.nanmean(x[pre]), np.nanmean(x[post])
+        x0, x1 = _hold_mean(x[pre]), _hold_mean(x[post])
         amp = abs(float(x1 - x0))
         if np.isfinite(amp) and amp > weight:
             best, weight = (x[lo : hi + 1] - x0) / (x1 - x0), amp
