@@ -21,6 +21,8 @@ hundredths of their width, and an hour's movements fit in memory.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import EffortError
@@ -65,17 +67,7 @@ def thinned(post: Posterior, keep: int = KEEP_DRAWS) -> Posterior:
     if n <= keep:
         return post
     rows = np.linspace(0, n - 1, keep).round().astype(int)
-    rho = None if post.rho is None else post.rho[rows]
-    return Posterior(
-        samples=post.samples[rows],
-        tau=post.tau,
-        acceptance=post.acceptance,
-        converged=post.converged,
-        steps=post.steps,
-        start=post.start,
-        rho=rho,
-        stop=post.stop,
-    )
+    return replace(post, samples=post.samples[rows], rho=None if post.rho is None else post.rho[rows])
 
 
 def consensus(posteriors, rng: np.random.Generator) -> Posterior:
