@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -54,3 +56,38 @@ def pose_model_path():
         if os.environ.get("C2N_REQUIRE_MODEL") == "1":
             pytest.fail(f"C2N_REQUIRE_MODEL=1 but the pose model is unavailable: {exc}")
         pytest.skip(f"BlazePose model unavailable (fetch impossible here): {exc}")
+
+
+#: Headless Chromium for the ``browser`` tests (None: they skip with the reason).
+CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Skip the ``browser`` tests, saying why, where Chromium is not installed."""
+    if CHROMIUM is not None:
+        return
+    skip = pytest.mark.skip(reason="chromium is not installed (apt-get install -y chromium)")
+    for item in items:
+        if "browser" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture
+def chromium(tmp_path):
+    """Return ``command(*flags)``: headless Chromium with a fresh profile and the flags every browser test needs."""
+
+    def command(*flags: str) -> list[str]:
+        return [
+            CHROMIUM,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            f"--user-data-dir={tempfile.mkdtemp(dir=tmp_path)}",
+            *flags,
+        ]
+
+    return command

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import subprocess
-import tempfile
 
 import cv2
 import numpy as np
@@ -20,11 +18,9 @@ import pytest
 from capture2notation.notation import render_staff
 from capture2notation.notation.formats import lab
 
-CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.browser,
-    pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (apt-get install -y chromium)"),
 ]
 
 SCORE = lab.loads("""\
@@ -57,25 +53,12 @@ window.addEventListener("load", () => {
 </script>"""
 
 
-def test_turn_front_sign_and_jump_are_drawn_in_chromium(tmp_path):
+def test_turn_front_sign_and_jump_are_drawn_in_chromium(tmp_path, chromium):
     svg = render_staff(SCORE, tmp_path / "staff.svg")
     inline = re.sub(r"^<\?xml[^>]*\?>", "", svg.read_text(encoding="utf-8"))
     page = tmp_path / "staff.html"
     page.write_text(f"<!doctype html><html><body style='margin:0'>{inline}{PROBE}</body></html>", encoding="utf-8")
-    common = [
-        CHROMIUM,
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        f"--user-data-dir={tempfile.mkdtemp(dir=tmp_path)}",
-        "--virtual-time-budget=5000",
-        "--hide-scrollbars",
-        "--force-device-scale-factor=1",
-    ]
+    common = chromium("--virtual-time-budget=5000", "--hide-scrollbars", "--force-device-scale-factor=1")
     dom = subprocess.run(common + ["--dump-dom", page.as_uri()], capture_output=True, text=True, timeout=120)
     m = re.search(r'<pre id="c2n-probe">(.*?)</pre>', dom.stdout, re.S)
     assert m, f"probe did not run; chromium said: {dom.stderr[-500:]}"

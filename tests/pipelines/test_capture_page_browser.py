@@ -20,7 +20,6 @@ import json
 import re
 import shutil
 import subprocess
-import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -33,11 +32,9 @@ from capture2notation.notation.formats import loads
 from pipelines.capture import capture
 from pipelines.capture_page import PLAYHEAD_COLOUR, index_html
 
-CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.browser,
-    pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (apt-get install -y chromium)"),
 ]
 
 SCORE = """\
@@ -116,30 +113,17 @@ window.addEventListener("load", () => {
 </script>"""
 
 
-def _chromium(tmp_path: Path, width: int, height: int) -> list[str]:
-    return [
-        CHROMIUM,
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--hide-scrollbars",
-        "--force-device-scale-factor=1",
-        "--autoplay-policy=no-user-gesture-required",
-        f"--user-data-dir={tempfile.mkdtemp(dir=tmp_path)}",
-        "--virtual-time-budget=8000",
-        f"--window-size={width},{height}",
-    ]
-
-
-def run_probe(page: Path, probe: str, tmp_path: Path, width: int, height: int) -> tuple[dict, np.ndarray]:
+def run_probe(page: Path, probe: str, tmp_path: Path, chromium, width: int, height: int) -> tuple[dict, np.ndarray]:
     """Open a copy of `page` with `probe` appended; return the probe's report and a screenshot (BGR)."""
     copy = page.with_name(f"probe_{width}_{page.name}")
     copy.write_text(page.read_text(encoding="utf-8").replace("</body>", probe + "</body>"), encoding="utf-8")
-    common = _chromium(tmp_path, width, height)
+    common = chromium(
+        "--hide-scrollbars",
+        "--force-device-scale-factor=1",
+        "--autoplay-policy=no-user-gesture-required",
+        "--virtual-time-budget=8000",
+        f"--window-size={width},{height}",
+    )
     dom = subprocess.run(common + ["--dump-dom", copy.as_uri()], capture_output=True, text=True, timeout=60)
     m = re.search(r'<pre id="c2n-probe">(.*?)</pre>', dom.stdout, re.S)
     assert m, f"probe did not report; chromium said: {dom.stderr[-500:]}"
@@ -179,13 +163,13 @@ def captured(tmp_path_factory):
 
 
 @pytest.mark.parametrize("width,height", [(1000, 760), (1400, 900)])
-def test_playhead_follows_the_video_and_rows_seek_it(captured, tmp_path, width, height):
+def test_playhead_follows_the_video_and_rows_seek_it(captured, tmp_path, chromium, width, height):
     res, _ = captured
     symbols = res.score.symbols
     # The row to click: a symbol on the second staff.
     k = next(i for i, s in enumerate(symbols) if s.start >= 8)
     probe = PROBE.replace("SEEK_S", f"{SEEK_S:g}").replace("ROW", str(k))
-    found, image = run_probe(res.outdir / "index.html", probe, tmp_path, width, height)
+    found, image = run_probe(res.outdir / "index.html", probe, tmp_path, chromium, width, height)
     start, seek, click = found["start"], found["seek"], found["click"]
 
     # Seeking moves the playhead up the first staff's beats onto the second staff (to the right).
@@ -221,10 +205,10 @@ def test_playhead_follows_the_video_and_rows_seek_it(captured, tmp_path, width, 
     assert _playhead_pixels(image, click["pane"]) >= 100
 
 
-def test_motion_file_page_has_a_slider_for_the_playhead(captured, tmp_path):
+def test_motion_file_page_has_a_slider_for_the_playhead(captured, tmp_path, chromium):
     _, root = captured
     res = capture(root / "r" / "truth.npz", tmp_path / "m", tempo=TEMPO, meter=1, progress=False, effort=False)
-    found, image = run_probe(res.outdir / "index.html", SCRUB_PROBE, tmp_path, 1000, 760)
+    found, image = run_probe(res.outdir / "index.html", SCRUB_PROBE, tmp_path, chromium, 1000, 760)
     # One second is two beats: the playhead moves up (y falls) by two beats of 48 px.
     assert found["y0"] - found["y1"] == pytest.approx(2 * 48, abs=0.01)
     assert found["max"] == pytest.approx((res.n_frames - 1) / FPS, abs=0.01)

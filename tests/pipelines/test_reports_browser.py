@@ -8,9 +8,7 @@ has width 0.
 
 import json
 import re
-import shutil
 import subprocess
-import tempfile
 from pathlib import Path
 
 import pytest
@@ -18,11 +16,9 @@ import pytest
 from pipelines.fidelity import StudyConfig, run_fidelity_study
 from pipelines.score import run_score
 
-CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.browser,
-    pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (apt-get install -y chromium)"),
 ]
 
 PROBE = """<script>
@@ -36,24 +32,11 @@ window.addEventListener("load", () => {
 </script>"""
 
 
-def open_in_chromium(report: Path, tmp_path: Path) -> dict:
+def open_in_chromium(report: Path, tmp_path: Path, chromium) -> dict:
     """Load `report` (with the probe) in headless Chromium; return the probe's findings."""
     probe = report.with_name("probe_" + report.name)
     probe.write_text(report.read_text(encoding="utf-8").replace("</body>", PROBE + "</body>"), encoding="utf-8")
-    profile = tempfile.mkdtemp(dir=tmp_path)
-    common = [
-        CHROMIUM,
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        f"--user-data-dir={profile}",
-        "--virtual-time-budget=10000",
-    ]
+    common = chromium("--disable-quic", "--virtual-time-budget=10000")
     dom = subprocess.run(common + ["--dump-dom", probe.as_uri()], capture_output=True, text=True, timeout=120)
     m = re.search(r'<pre id="c2n-probe">(.*?)</pre>', dom.stdout, re.S)
     assert m, f"probe did not run; chromium said: {dom.stderr[-500:]}"
@@ -74,18 +57,18 @@ def check_all_images(found: dict, expected: set[str]):
     assert found["screenshot_bytes"] > 20_000  # a rendered page, not a blank one
 
 
-def test_score_report_in_chromium(tmp_path):
+def test_score_report_in_chromium(tmp_path, chromium):
     lab = tmp_path / "p.lab"
     lab.write_text("tempo: 60\n0 1 right_arm forward middle\n1 1 left_arm left high\n")
     slow = tmp_path / "slow.lab"
     slow.write_text("tempo: 45\n0 1 right_arm forward middle\n1 1 left_arm left middle\n")
     run_score(slow, lab, tmp_path / "score")
-    found = open_in_chromium(tmp_path / "score" / "report.html", tmp_path)
+    found = open_in_chromium(tmp_path / "score" / "report.html", tmp_path, chromium)
     check_all_images(found, {"plots/key_poses.png", "plots/errors.png", "plots/effort.png"})
     assert found["title"].startswith("Score:") and found["h2"] >= 4
 
 
-def test_fidelity_report_in_chromium(tmp_path):
+def test_fidelity_report_in_chromium(tmp_path, chromium):
     cfg = StudyConfig(
         phrases=("figure7",),
         emotions=("happy", "sad"),
@@ -101,7 +84,7 @@ def test_fidelity_report_in_chromium(tmp_path):
         bootstrap=3,
     )
     run_fidelity_study(cfg, tmp_path / "study", workers=1, progress=False)
-    found = open_in_chromium(tmp_path / "study" / "report.html", tmp_path)
+    found = open_in_chromium(tmp_path / "study" / "report.html", tmp_path, chromium)
     check_all_images(
         found,
         {
