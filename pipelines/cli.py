@@ -130,3 +130,7 @@ def main(verbose: int) -> None:
 
 for _module, _attr in _COMMANDS:
     main.add_command(getattr(importlib.import_module(f"pipelines.commands.{_module}"), _attr))
+
+
+if __name__ == "__main__":  # ``python -m pipelines.cli`` as well as the ``c2n`` script
+    main()
