@@ -237,3 +237,12 @@ def test_floor_option_takes_auto_or_a_height_and_names_a_bad_value(fixture_path,
     assert "Traceback" not in err
     code, _out, err = _run("capture", "--help")
     assert "--floor auto|HEIGHT_M" in " ".join(err.split() + _out.split())
+
+
+def test_python_dash_m_runs_the_command_line():
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "pipelines.cli", "--help"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "capture" in r.stdout and "Usage:" in r.stdout
