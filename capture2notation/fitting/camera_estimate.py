@@ -92,6 +92,12 @@ class CameraEstimate:
         Frames used (at most :data:`MAX_FRAMES`, evenly spread over the clip).
     contacts : int
         Frames whose lowest foot point was within 2 sd of the floor.
+    focal_resolved : bool
+        False when the best focal length lies at an end of the searched
+        fields of view (:data:`HFOV_RANGE_DEG`): the person's perspective
+        did not determine it, and its bootstrap spread (0 when every
+        resample runs to the same end) says nothing; the height and the
+        floor, which scale with it, are then uncertain by as much.
     """
 
     focal_px: float
@@ -106,6 +112,7 @@ class CameraEstimate:
     up: tuple
     frames: int
     contacts: int
+    focal_resolved: bool = True
 
     def as_dict(self) -> dict:
         """Plain fields (for ``capture.npz`` and JSON)."""
@@ -120,8 +127,13 @@ class CameraEstimate:
 
     def line(self) -> str:
         """One line a person reads."""
+        lens = (
+            f"{self.hfov_deg:.0f}° field of view (focal {self.focal_px:.0f} ± {self.focal_sd_px:.0f} px)"
+            if self.focal_resolved
+            else f"field of view not resolved from the person (its fit runs to the searched limit, {self.hfov_deg:.0f}°)"
+        )
         return (
-            f"camera estimated: {self.hfov_deg:.0f}° field of view (focal {self.focal_px:.0f} ± {self.focal_sd_px:.0f} px), "
+            f"camera estimated: {lens}, "
             f"{self.height_m:.2f} ± {self.height_sd_m:.2f} m high, pitch {self.pitch_deg:+.1f} ± {self.pitch_sd_deg:.1f}°, "
             f"roll {self.roll_deg:+.1f} ± {self.roll_sd_deg:.1f}° ({self.contacts} of {self.frames} frames on the floor)"
         )
@@ -169,11 +181,13 @@ def _reprojection_cost(f: float, uv, W, w) -> float:
     return float(np.nansum(w * np.log1p(np.where(np.isfinite(r), r, 1e3) ** 2)))
 
 
-def _best_focal(uv, W, w, width: float) -> float:
+def _best_focal(uv, W, w, width: float) -> tuple[float, bool]:
+    """The focal length of least robust reprojection cost, and whether it lies inside the searched range."""
     lo, hi = (0.5 * width / np.tan(np.radians(a) / 2) for a in HFOV_RANGE_DEG[::-1])
     grid = np.geomspace(lo, hi, 33)
     costs = np.array([_reprojection_cost(f, uv, W, w) for f in grid])
     i = int(np.argmin(costs))
+    inside = 0 < i < len(grid) - 1
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
     for _ in range(20):  # golden section on the bracket
         m1, m2 = a + 0.382 * (b - a), a + 0.618 * (b - a)
@@ -181,7 +195,7 @@ def _best_focal(uv, W, w, width: float) -> float:
             b = m2
         else:
             a = m1
-    return 0.5 * (a + b)
+    return 0.5 * (a + b), inside
 
 
 def _rest_heights(body: Body) -> tuple[float, np.ndarray]:
@@ -240,14 +254,14 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
     if len(leg_ok) >= MIN_FRAMES:
         Wf = Wf * (leg_model / float(np.median(leg_ok)))
 
-    f = _best_focal(uv, Wf, wts, w_img)
+    f, resolved = _best_focal(uv, Wf, wts, w_img)
     rng = np.random.default_rng(seed)
     n_blocks = max(1, len(frames) // BLOCK_FRAMES)
     blocks = np.array_split(np.arange(len(frames)), n_blocks)
     boot = []
     for _ in range(BOOTSTRAP if n_blocks > 1 else 0):
         pick = np.concatenate([blocks[i] for i in rng.integers(0, n_blocks, n_blocks)])
-        boot.append(_best_focal(uv[pick], Wf[pick], wts[pick], w_img))
+        boot.append(_best_focal(uv[pick], Wf[pick], wts[pick], w_img)[0])
     f_sd = float(np.std(boot, ddof=1)) if len(boot) > 1 else float("nan")
 
     P = Wf + _translations(f, uv, Wf, wts)[:, None]
@@ -292,4 +306,5 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
         up=tuple(float(v) for v in up_vector(pitch, roll)),
         frames=len(frames),
         contacts=contacts,
+        focal_resolved=resolved,
     )

@@ -73,3 +73,14 @@ def test_render_camera_options_out_of_range_are_one_line(option, value, tmp_path
     assert r.exit_code == 2
     errors = [ln for ln in r.output.splitlines() if ln.strip()]
     assert len(errors) == 1 and errors[0].startswith("c2n: error:") and option in errors[0]
+
+
+def test_a_lens_outside_the_searched_range_is_reported_unresolved():
+    # A 20° telephoto lies outside HFOV_RANGE_DEG (30-110°): the search runs
+    # to its 30° end, which must not be reported as a measured field of view.
+    cam = Camera.phone("front", SIZE, 1.7, 1.0, 0.0, 0.0, 20.0)
+    est = estimate_camera(*_landmarks(3, cam, px_noise=0.5, world_noise=0.005), SIZE)
+    assert est is not None and not est.focal_resolved
+    assert "not resolved" in est.line() and "±" not in est.line().split(",")[0]
+    inside = estimate_camera(*_landmarks(3, Camera.phone("front", SIZE, 1.7, 1.0, 0.0, 0.0, 60.0)), SIZE)
+    assert inside is not None and inside.focal_resolved and "field of view (focal" in inside.line()
