@@ -72,6 +72,13 @@ class FitOptions:
         foot under DESIGN.md's 0.2 m/s support speed at a pixel of keypoint
         noise, but smooth away the pauses that mark leg gestures: whole-path
         symbol agreement through BlazePose fell by 4–7 points.
+    planted_speed : float
+        Scale of the Cauchy prior on each foot point's speed in the exact
+        smoothing pass, m/s (:func:`~capture2notation.fitting.temporal.
+        _foot_speed_rows`); 0 switches it off.  Feet mostly stand still or
+        move fast, so a heavy-tailed prior holds a planted foot where a
+        single view's depth would let it slide, and lets a stepping or
+        gesturing foot go.
     sigma_rest, sigma_twist : float
         Spread of the pull to the rest pose for swings and for twists, radians.
     sigma_spine_twist : float
@@ -138,6 +145,7 @@ class FitOptions:
     sigma_smooth: float = 0.08
     sigma_root_smooth: float = 0.02
     sigma_leg_smooth: float = 0.08
+    planted_speed: float = 0.1
     sigma_rest: float = 4.0
     sigma_pelvis: float = 0.1
     sigma_trunk: float = 0.2

@@ -19,7 +19,9 @@ so ``S_t`` is the precision with which frame ``t`` alone measures them
 
     Σ_t ½ δ_tᵀ S_t δ_t + s_tᵀ δ_t + ½ Σ_t ‖Λ^½ Δ²(x + δ)_t‖²,
 
-a sparse banded system of ``kT`` unknowns, and the other angles follow by
+a sparse banded system of ``kT`` unknowns (with ``FitOptions.planted_speed``
+also a heavy-tailed prior on the feet's speed, which the coupled parameters
+alone move; :func:`_foot_speed_rows`), and the other angles follow by
 the conditional Gauss–Newton step ``δa_t = −H_aa⁻¹ (g_a + H_ax δ_t)``.  The
 root and legs therefore move only as much as each frame's evidence supports.
 """
@@ -34,6 +36,7 @@ from ..body import JOINTS
 from .model import PoseModel
 from .solver import (
     CHUNK,
+    FOOT_POINTS,
     FitOptions,
     Terms,
     _normal_equations,
@@ -42,6 +45,11 @@ from .solver import (
 )
 
 __all__ = ["COUPLED", "coupled_params", "smooth_root"]
+
+#: Frame rate at which the priors' strengths are stated; a term per frame
+#: pair is weighted by ``REFERENCE_FPS / fps`` so a prior means as much per
+#: second at any rate.
+REFERENCE_FPS = 25.0
 
 #: Joints whose angles are smoothed together with the root: they carry the feet.
 COUPLED = ("pelvis", "right_hip", "left_hip", "right_knee", "left_knee", "right_ankle", "left_ankle")
@@ -56,6 +64,69 @@ def coupled_params(model: PoseModel, joints: tuple[str, ...] = COUPLED) -> np.nd
 def _second_difference(T: int):
     """(T−2, T) sparse second-difference operator."""
     return diags([np.ones(T - 2), -2.0 * np.ones(T - 2), np.ones(T - 2)], [0, 1, 2], shape=(T - 2, T))
+
+
+def _foot_speed_rows(model: PoseModel, params: np.ndarray, cp: np.ndarray, fps: float, scale: float):
+    """Whitened rows of the feet's speed prior, linearised at `params`.
+
+    Each foot point's velocity between neighbouring frames has a Cauchy
+    (Student-t, one degree of freedom) prior of scale `scale` m/s: mostly
+    still, now and then moving at any speed.  Its negative log density
+    ``log(1 + v²/c²)`` is applied by iteratively reweighted least squares,
+    the quadratic ``½ w ‖v‖²`` with ``w = 2 / (c² + ‖v‖²)`` at the current
+    velocity.  A foot that the views see still is held still in depth, which
+    a single view measures only through the figure's image scale (a fit
+    otherwise slides or lifts a standing foot along its line of sight); a
+    foot the views see moving fast costs the fit almost nothing.  A foot
+    moving slowly and mostly along the line of sight is held back too.
+
+    Parameters
+    ----------
+    model : PoseModel
+    params : (T, 3 + D) ndarray
+    cp : (k,) ndarray
+        Indices of the coupled parameters (the unknowns of the smoothing).
+    fps : float
+    scale : float
+        The prior's scale, m/s.
+
+    Returns
+    -------
+    B : (3 F (T − 1), k T) sparse matrix
+        d(whitened velocity)/d(coupled parameters), ``F`` foot points.
+    r0 : (3 F (T − 1),) ndarray
+        Whitened velocities at `params`.
+    """
+    T = params.shape[0]
+    k = len(cp)
+    idx = np.array([model.index(n) for n in FOOT_POINTS])
+    F = len(idx)
+    pts = np.empty((T, F, 3))
+    jac = np.empty((T, F, 3, k))
+    for a in range(0, T, CHUNK):
+        sl = slice(a, min(T, a + CHUNK))
+        p, j = model.forward(params[sl], jacobian=True)
+        pts[sl] = p[:, idx]
+        jac[sl] = j[:, idx][..., cp]
+    vel = (pts[1:] - pts[:-1]) * fps  # (T − 1, F, 3) m/s
+    speed2 = np.nan_to_num(np.sum(vel**2, axis=-1), nan=np.inf)
+    per_s = REFERENCE_FPS / fps if fps > 0 else 1.0
+    sw = np.sqrt(2.0 * per_s / (scale**2 + speed2))[..., None]  # (T − 1, F, 1)
+    r0 = np.nan_to_num(sw * vel).reshape(-1)
+    after = np.nan_to_num(sw[..., None] * fps * jac[1:])  # (T − 1, F, 3, k)
+    before = -np.nan_to_num(sw[..., None] * fps * jac[:-1])
+    n_rows = 3 * F * (T - 1)
+    rows = np.repeat(np.arange(n_rows), k)
+    t = np.repeat(np.arange(T - 1), 3 * F * k)
+    col = np.tile(np.arange(k), n_rows)
+    B = csc_matrix(
+        (
+            np.concatenate([before.reshape(-1), after.reshape(-1)]),
+            (np.concatenate([rows, rows]), np.concatenate([t * k + col, (t + 1) * k + col])),
+        ),
+        shape=(n_rows, k * T),
+    )
+    return B, r0
 
 
 def smooth_root(
@@ -110,7 +181,7 @@ def smooth_root(
         s[sl] = g[:, :k] - (Hra @ X[sl][..., k:])[..., 0]
     # The temporal term (θ_t − (θ_{t−1} + θ_{t+1}) / 2) is half a second difference.
     prec = smooth[cp].copy()
-    scale = 25.0 / fps if fps > 0 else 1.0
+    scale = REFERENCE_FPS / fps if fps > 0 else 1.0
     prec[:3] = np.maximum(prec[:3], 1.0 / (opt.sigma_root_smooth * scale) ** 2)
     prec[3:] = np.maximum(prec[3:], 1.0 / (opt.sigma_leg_smooth * scale) ** 2)
     lam = np.tile(0.25 * prec, T)
@@ -123,7 +194,12 @@ def smooth_root(
     x = params[:, cp].reshape(-1)
     # A tiny ridge keeps clips with unseen stretches (zero S_t, no trend) solvable.
     A = (blocks + DtD + 1e-9 * identity(k * T)).tocsc()
-    delta = spsolve(A, -s.reshape(-1) - DtD @ x).reshape(T, k)
+    rhs = -s.reshape(-1) - DtD @ x
+    if opt.planted_speed > 0:
+        B, r0 = _foot_speed_rows(model, params, cp, fps, opt.planted_speed)
+        A = (A + B.T @ B).tocsc()
+        rhs -= B.T @ r0
+    delta = spsolve(A, rhs).reshape(T, k)
     out = params.copy()
     out[:, cp] += delta
     # The other angles' conditional step given the coupled ones (X[..., :k] = Haa⁻¹ H_ar).

@@ -9,6 +9,7 @@ from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
 from capture2notation.errors import FittingError
 from capture2notation.fitting import (
     Camera,
+    FitOptions,
     FitResult,
     fit_keypoints,
     fit_points3d,
@@ -16,6 +17,13 @@ from capture2notation.fitting import (
 )
 
 T = 40
+
+
+#: `synth.make_motion`'s figure sways its root while both feet follow: its
+#: feet glide at 0.1-0.4 m/s all clip long, which the feet's speed prior
+#: (planted or moving fast, ``FitOptions.planted_speed``) does not describe
+#: and holds back by 2-3 cm.  Tests of the rest of the fit on it switch it off.
+GLIDING = FitOptions(planted_speed=0.0)
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +41,7 @@ def _mpjpe(a, b):
 def test_clean_keypoints_with_world_landmarks_are_fitted_closely(scene, synth):
     body, ang, root, cam = scene
     xy, conf, world, truth = synth.observe(ang, root, cam, body)
-    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world, options=GLIDING)
     assert isinstance(res, FitResult)
     assert res.joints.shape == (T, len(JOINTS), 3) and res.confidence.shape == (T, len(JOINTS))
     assert _mpjpe(res.joints, truth) < 0.02
@@ -96,7 +104,7 @@ def test_missing_landmarks_lower_confidence_and_empty_frames_are_nan(scene, synt
     conf[10:20, 16] = 0.0
     world[10:20, 16] = np.nan
     xy[30:33], conf[30:33], world[30:33] = np.nan, 0.0, np.nan
-    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world)
+    res = fit_keypoints(xy, conf, 25.0, camera=cam, world=world, options=GLIDING)
     rw = joint_index("right_wrist")
     assert np.all(res.confidence[10:20, rw] == 0.0)
     assert np.all(res.confidence[:10, rw] > 0.8)
