@@ -190,9 +190,12 @@ class Support:
         """Plan-coordinate pivot track of `turn` (:mod:`synthetic.turning`), None to pivot about the pelvis.
 
         Per frame, the mean centre (midpoint of ankle and toe) of the feet
-        bearing weight at the turn's end: a centre moves only as its foot
-        rises or lowers, so the foot spins on the spot.  None in the air or
-        with no foot bearing weight.
+        the weight arrives on at the turn's end: a centre moves only as its
+        foot rises or lowers, so the foot spins on the spot.  A gesture or
+        support beginning at that beat has not yet moved the weight (it
+        begins there, DESIGN.md), so a turn on both feet that ends as one
+        lifts still pivots about both.  None in the air or with no foot
+        bearing weight.
 
         Returns
         -------
@@ -200,7 +203,7 @@ class Support:
         """
         if any(a.is_air and a.start < turn.end and turn.start < a.end for a in self.sups):
             return None
-        feet = _weight_feet(self.sups, self.events, turn.end)
+        feet = _weight_feet(self.sups, self.events, turn.end, arriving=True)
         if not feet:
             return None
         toe = self.body.offsets[joint_index("right_toe")]

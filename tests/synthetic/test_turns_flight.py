@@ -113,6 +113,25 @@ def test_steps_travel_relative_to_the_front():
     assert abs(moved[1]) < 1e-6
 
 
+def test_a_turn_on_both_feet_pivots_about_their_midpoint_though_one_lifts_as_it_ends():
+    # The turn is done on both feet; the relevé on the left and the right
+    # leg's gesture begin as it ends (DESIGN.md: a movement begins at its
+    # start), so the feet slide round their midpoint (synthetic.turning).
+    # Pivoting on the left foot alone swung the right one at 0.4 m/s.
+    score = lab.loads("tempo: 101\n0 2 turn left amount=1/4\n2 2 left_support place high\n2 2 right_leg right low\n")
+    J = interpret(score, fps=FPS).joints()
+    centre = {
+        side: 0.5 * (J[:, joint_index(f"{side}_ankle")] + J[:, joint_index(f"{side}_toe")])[:, :2]
+        for side in ("right", "left")
+    }
+    during = slice(0, _frame(2, score) + 1)
+    mid = 0.5 * (centre["right"] + centre["left"])[during]
+    assert np.abs(mid - mid[0]).max() < 1e-6
+    # Both feet slide alike, each at half the speed of the one swung before.
+    speed = {k: np.linalg.norm(np.diff(v[during], axis=0), axis=1) * FPS for k, v in centre.items()}
+    np.testing.assert_allclose(speed["right"], speed["left"], atol=1e-6)
+
+
 def test_body_key_arms_follow_the_torso():
     text = "tempo: 60\n0 2 chest forward high\n2 2 right_arm forward middle\n"
     standard, body = lab.loads(text), lab.loads("axes: body\n" + text)
