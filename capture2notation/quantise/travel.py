@@ -54,7 +54,9 @@ def unturn(joints: np.ndarray, turned_deg: np.ndarray, contact: np.ndarray) -> n
         ``R(θ_t) x + c_t`` per frame with θ_t the front turned (clockwise, so
         the rotation undoing it is counter-clockwise by θ_t) and ``c_t``
         chosen so that the pivot's unturned position changes only as the
-        pivot itself moves.
+        pivot itself moves; in the air the pelvis's unturned path is its
+        room path turned by the front it took off with (DESIGN.md: it flies
+        straight while the body turns about it).
     """
     joints = np.asarray(joints, float)
     T = joints.shape[0]
@@ -71,7 +73,17 @@ def unturn(joints: np.ndarray, turned_deg: np.ndarray, contact: np.ndarray) -> n
     pivot = np.where((n > 0)[:, None], feet, pelvis)
     pivot = np.where(np.isfinite(pivot), pivot, 0.0)
     shift = np.zeros((T, 2))
+    take_off = R[0]  # the rotation undoing the front the body last stood with
     for t in range(1, T):
+        if n[t] == 0 and np.all(np.isfinite(pelvis[t - 1 : t + 1])):
+            # In the air the pelvis flies straight along the front it took
+            # off with while the body turns about it: its unturned path is
+            # its room path turned by the take-off front only.
+            shift[t] = (
+                R[t - 1] @ pelvis[t - 1] + shift[t - 1] + take_off @ (pelvis[t] - pelvis[t - 1]) - R[t] @ pelvis[t]
+            )
+            continue
+        take_off = R[t]
         if theta[t] == theta[t - 1]:
             shift[t] = shift[t - 1]
             continue

@@ -93,6 +93,22 @@ def test_written_turns_round_trip_on_two_feet():
     assert score_differences(score, seg.score) == []
 
 
+@pytest.mark.parametrize("amount, landing", [("1", "left"), ("1/4", "forward")])
+def test_a_landing_after_a_turn_in_the_air_keeps_its_written_direction(amount, landing):
+    # The pelvis flies straight along the front it took off with while the
+    # body turns about it; undoing the turn frame by frame about the flying
+    # pelvis curled its path (a full turn's travel came back to 'place').
+    from capture2notation.notation.formats import lab
+
+    score = lab.loads(
+        f"tempo: 85\n0 1 support place low\n1 1/2 support air\n1 1/2 turn right amount={amount}\n"
+        f"3/2 1/2 left_support {landing} low\n2 1 support place middle\n"
+    )
+    seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
+    landed = [s for s in seg.score.symbols if s.part == "left_support"]
+    assert [(s.start, s.direction, s.level) for s in landed] == [(Fraction(3, 2), landing, "low")]
+
+
 def test_kinect_body_key_reproduces_labanotationsuite_labels(fixture_path):
     """LabanotationSuite's per-frame arm labels (an independent reference) from ``--axes body``."""
     import json
