@@ -317,14 +317,21 @@ def _key_pose_fn(
     return key
 
 
-def _weight_arrivals(joints: np.ndarray) -> np.ndarray:
+#: A weight arrival is a minimum of the pelvis's speed below this fraction of
+#: the speed it reached since the previous arrival: each support movement is
+#: one smooth push that starts and ends at (or near) rest.
+ARRIVAL_DEPTH = 0.5
+
+
+def _weight_arrivals(joints: np.ndarray, supporting: np.ndarray) -> np.ndarray:
     """(T,) bool: frames where the weight arrives (clean motion).
 
     The pelvis moves with the supports only, each support movement in one
     smooth push: it comes to rest, or — a support following back to back,
     which starts from rest — slows to a minimum of its speed, where a
     support movement arrives.  That may be the very frame a leg gesture
-    starts.
+    starts.  The weight arrives on a foot: in the air (`supporting`, (T, 2),
+    no foot) the pelvis's slowest frame is the top of its flight.
     """
     step = np.linalg.norm(np.diff(joints[:, joint_index("pelvis")], axis=0), axis=-1)
     out = np.zeros(len(joints), bool)
@@ -333,7 +340,15 @@ def _weight_arrivals(joints: np.ndarray) -> np.ndarray:
     nxt = np.r_[step[1:], 0.0]
     after = np.r_[step[2:], np.inf, np.inf]
     out[1:] = (step > 1e-9) & (nxt < step) & (nxt <= after)
-    return out
+    # A push that arrives slows to a fraction of its peak; a shallow dip is
+    # not one (the unturned pelvis of a fast pirouette wobbles by a few cm/s).
+    speed, last = np.r_[step, 0.0], 0  # at rest after the clip
+    for f in np.flatnonzero(out):
+        if not speed[f] < ARRIVAL_DEPTH * speed[last:f].max(initial=0.0):
+            out[f] = False
+        else:
+            last = f
+    return out & np.asarray(supporting, bool).any(axis=1)
 
 
 def _noise_speed(noise: float, fps: float, window: int) -> float:
@@ -482,7 +497,7 @@ def gesture_movements(
             # the knee): it gestures only between leaving and reaching the floor.
             down = labels.supporting[:, _FOOT[part]]
             speed = np.where(down[:-1] & down[1:], 0.0, speed)
-        arrivals = _weight_arrivals(joints) if clean and part in _FOOT else None
+        arrivals = _weight_arrivals(joints, labels.supporting) if clean and part in _FOOT else None
         key = _key_pose_fn(labels, part, on_grid, arrivals=arrivals) if clean else None
         # Noisy motion: a shallower minimum parts two movements where the
         # part passes within _NEAR_POSE_DEG of a written pose.

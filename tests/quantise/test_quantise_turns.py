@@ -109,6 +109,31 @@ def test_a_landing_after_a_turn_in_the_air_keeps_its_written_direction(amount, l
     assert [(s.start, s.direction, s.level) for s in landed] == [(Fraction(3, 2), landing, "low")]
 
 
+@pytest.mark.parametrize(
+    "text",
+    [
+        # A leap whose back leg gestures from the take-off: the top of the
+        # flight (the pelvis's slowest frame) is no arrival of the weight.
+        (
+            "tempo: 85\n0 1 support place low\n1 1 right_leg left_back low\n1 1/2 support air\n"
+            "3/2 1/2 left_support left low\n2 1 support place middle\n"
+        ),
+        # A pirouette on the left foot while the right leg opens: the unturned
+        # pelvis wobbles in the fast turn, which is no arrival either.
+        (
+            "tempo: 101\n0 2 turn left amount=1/4\n2 2 left_support place high\n2 2 right_leg right low\n"
+            "2 2 turn left amount=15/8\n4 3/2 support place middle\n"
+        ),
+    ],
+)
+def test_a_leg_gesture_begun_with_a_leap_or_a_pirouette_starts_on_its_beat(text):
+    from capture2notation.notation.formats import lab
+
+    score = lab.loads(text)
+    seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
+    assert score_differences(score, seg.score) == []
+
+
 def test_kinect_body_key_reproduces_labanotationsuite_labels(fixture_path):
     """LabanotationSuite's per-frame arm labels (an independent reference) from ``--axes body``."""
     import json
