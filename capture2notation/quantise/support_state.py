@@ -289,9 +289,17 @@ def step_direction(
             continue
         if starts is not None and not plausible_step(joints, f, af, k, height):
             continue
-        rel = foot - joints[af, joint_index(f"{side}_hip")]
-        if offset is not None:
-            rel = rel - offset[f]
+        other = ("left", "right")[f]
+        if not labels.supporting[af, f] and labels.supporting[af, 1 - f]:
+            # A free foot comes down relative to the foot bearing the weight:
+            # beside it at the hips' spacing is 'place' (a closing foot),
+            # wherever the pelvis stood over the supporting foot.
+            spacing = joints[af, joint_index(f"{side}_hip")] - joints[af, joint_index(f"{other}_hip")]
+            rel = foot - (joints[af, joint_index(f"{other}_ankle")] + spacing)
+        else:
+            rel = foot - joints[af, joint_index(f"{side}_hip")]
+            if offset is not None:
+                rel = rel - offset[f]
         rel[2] = 0.0
         dist = float(np.linalg.norm(rel))
         if dist > best_d:

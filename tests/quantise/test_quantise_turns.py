@@ -124,9 +124,15 @@ def test_a_landing_after_a_turn_in_the_air_keeps_its_written_direction(amount, l
             "tempo: 101\n0 2 turn left amount=1/4\n2 2 left_support place high\n2 2 right_leg right low\n"
             "2 2 turn left amount=15/8\n4 3/2 support place middle\n"
         ),
+        # After a hop that turns and lands on the right foot with the pelvis
+        # over it, the free left foot closes beside it: 'place', not a step.
+        (
+            "tempo: 86\n0 2 left_leg forward low\n0 2 right_support place low\n2 1/2 support air\n"
+            "2 1/2 turn right amount=1/4\n5/2 3/4 right_support forward low\n13/4 3/2 support place middle\n"
+        ),
     ],
 )
-def test_a_leg_gesture_begun_with_a_leap_or_a_pirouette_starts_on_its_beat(text):
+def test_leaps_pirouettes_and_a_closing_foot_round_trip_exactly(text):
     from capture2notation.notation.formats import lab
 
     score = lab.loads(text)
