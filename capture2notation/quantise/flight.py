@@ -124,7 +124,11 @@ def _rest_frame(joints: np.ndarray, t1: int, fps: float, on_grid: np.ndarray | N
         # A deep minimum: the dip of a plié absorbing the landing slows the
         # pelvis too, but only to a fifth of its touchdown speed.
         deep = s[m + 1] <= _REST_FRACTION * peak
-        if s[m + 1] <= 1e-9 or (deep and s[m] >= s[m + 1] <= s[min(m + 2, s.size - 1)]):
+        # The bottom of that dip (the pelvis stops sinking and rises again)
+        # is no rest, however slow: a landing on the spot passes through it
+        # at almost no speed.
+        bottom = p[f, 2] < p[f - 1, 2] and p[min(f + 2, T - 1), 2] > p[f + 1, 2]
+        if s[m + 1] <= 1e-9 or (deep and not bottom and s[m] >= s[m + 1] <= s[min(m + 2, s.size - 1)]):
             g = f + 1 if s[m + 1] > 1e-9 else f
             for cand in (g, g - 1, g + 1):
                 if t1 < cand < T and (on_grid is None or on_grid[cand]):

@@ -130,9 +130,15 @@ def test_a_landing_after_a_turn_in_the_air_keeps_its_written_direction(amount, l
             "tempo: 86\n0 2 left_leg forward low\n0 2 right_support place low\n2 1/2 support air\n"
             "2 1/2 turn right amount=1/4\n5/2 3/4 right_support forward low\n13/4 3/2 support place middle\n"
         ),
+        # A jump landing on the spot sinks below its plié and rises to it:
+        # the bottom of that dip, passed at almost no speed, is no rest.
+        (
+            "tempo: 77\n0 2 support place low\n2 1/2 support air\n5/2 3/4 support place low\n"
+            "13/4 1 support place middle\n"
+        ),
     ],
 )
-def test_leaps_pirouettes_and_a_closing_foot_round_trip_exactly(text):
+def test_leaps_pirouettes_landings_and_a_closing_foot_round_trip_exactly(text):
     from capture2notation.notation.formats import lab
 
     score = lab.loads(text)
