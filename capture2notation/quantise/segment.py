@@ -250,11 +250,21 @@ def segment_motion(
         turns = turn_movements(turning, fps, measured, on_grid)
         ends = np.zeros(T, bool)
         ends[[min(m.end_frame, T - 1) for m in turns]] = True
+        take_offs = np.zeros(T, bool)
+        take_offs[[t0 for t0, _ in flights]] = True
         moves = (
             gesture_movements(labels, joints, fps, params, on_grid, measured)
             + with_flights(
                 support_movements(
-                    labels, joints, fps, params, movement_spans, on_grid, measured=measured, turn_ends=ends
+                    labels,
+                    joints,
+                    fps,
+                    params,
+                    movement_spans,
+                    on_grid,
+                    measured=measured,
+                    turn_ends=ends,
+                    take_offs=take_offs,
                 )
                 if floor_seen
                 else [],

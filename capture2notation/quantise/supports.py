@@ -58,6 +58,7 @@ def support_movements(
     on_grid: np.ndarray | None = None,
     measured: bool = False,
     turn_ends: np.ndarray | None = None,
+    take_offs: np.ndarray | None = None,
 ) -> list:
     """Support movements as :class:`~.segment.Movement` objects (see the module docstring).
 
@@ -67,7 +68,10 @@ def support_movements(
     of smoothed joints (:func:`smooth_positions`, as
     :func:`~.segment.segment_motion` does).  `turn_ends` (T,) bool, clean
     motion: frames where a turn arrives, where a support on one foot may
-    part too (a pirouette's relevé ends with its turn).
+    part too (a pirouette's relevé ends with its turn).  `take_offs` (T,)
+    bool, clean motion: the first frame of each flight
+    (:func:`~.flight.find_flights`), where the support sprung from arrives
+    (its span would otherwise run on to the landing).
     """
 
     T = joints.shape[0]
@@ -90,7 +94,11 @@ def support_movements(
         axis=1,
     )
     spans = spans_fn(
-        speed, 1e-4, 2e-4, params.split_ratio, key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps, turn_ends)
+        speed,
+        1e-4,
+        2e-4,
+        params.split_ratio,
+        key_pose=_support_cut_fn(labels, speed, on_grid, knees, fps, turn_ends, take_offs),
     )
     height = body_height(joints)
     state = (0, LEVELS.index("middle"), "place")
@@ -120,6 +128,7 @@ def _support_cut_fn(
     knees=None,
     fps: float = 25.0,
     turn_ends: np.ndarray | None = None,
+    take_offs: np.ndarray | None = None,
 ):
     """``(f, since) -> bool`` for :func:`~.segment.movement_spans`: frame f may part two support movements.
 
@@ -140,7 +149,7 @@ def _support_cut_fn(
     def key(f: int, since: int) -> bool:
         if on_grid is not None and not on_grid[f]:
             return False
-        if landed[f]:
+        if landed[f] or (take_offs is not None and take_offs[f]):
             return True
         if not down[f] and not (turn_ends is not None and turn_ends[f] and sup[f].any()):
             return False

@@ -136,6 +136,12 @@ def test_a_landing_after_a_turn_in_the_air_keeps_its_written_direction(amount, l
             "tempo: 77\n0 2 support place low\n2 1/2 support air\n5/2 3/4 support place low\n"
             "13/4 1 support place middle\n"
         ),
+        # A hop sprung from a plié on one foot beside a gesture: that support
+        # arrives at the take-off (its span once ran on to the landing).
+        (
+            "tempo: 112\n0 2 left_leg right_back low\n0 2 right_support place low\n2 3/4 support air\n"
+            "11/4 1/2 support place low\n13/4 3/2 support place middle\n"
+        ),
     ],
 )
 def test_leaps_pirouettes_landings_and_a_closing_foot_round_trip_exactly(text):
