@@ -199,7 +199,8 @@ def main() -> None:
     ap.add_argument("--video", type=int, default=0, help="random scores to render and capture from video")
     ap.add_argument("--skip-bvh", action="store_true")
     args = ap.parse_args()
-    round_trip(args.seeds, args.seed0)
+    if args.seeds > 0:  # --seeds 0: the video figures alone
+        round_trip(args.seeds, args.seed0)
     kinect()
     if not args.skip_bvh:
         bvh()
