@@ -197,6 +197,7 @@ def main() -> None:
         "--seed0", type=int, default=20260000, help="first seed (development: 20260000; fresh: e.g. 20270000)"
     )
     ap.add_argument("--video", type=int, default=0, help="random scores to render and capture from video")
+    ap.add_argument("--video-seed0", type=int, default=20261400, help="first seed of the --video scores")
     ap.add_argument("--skip-bvh", action="store_true")
     args = ap.parse_args()
     if args.seeds > 0:  # --seeds 0: the video figures alone
@@ -205,7 +206,7 @@ def main() -> None:
     if not args.skip_bvh:
         bvh()
     if args.video:
-        video(args.video)
+        video(args.video, args.video_seed0)
 
 
 if __name__ == "__main__":

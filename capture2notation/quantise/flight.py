@@ -97,15 +97,20 @@ def _ballistic(joints: np.ndarray, t0: int, t1: int, fps: float) -> bool:
     """Whether the pelvis falls freely between take-off `t0` and touchdown `t1`.
 
     Both feet can clear the floor's 3 cm for a frame or two in a quick step
-    (the back foot's toe lifts as the front foot lands); the pelvis then
-    moves smoothly.  In flight it decelerates upwards and falls: its mean
-    vertical acceleration is near −g.
+    (the back foot's toe lifts as the front foot lands), or float a few
+    centimetres above a floor found a little low; the pelvis then moves
+    smoothly.  In flight it rises and falls on a parabola: over a flight of
+    ``D`` seconds it peaks ``g D² / 8`` above the line from take-off to
+    touchdown, so its mean vertical acceleration is ``−8 · rise / D²``,
+    near −g.  The rise is what a fitted pelvis keeps best; its velocities
+    at take-off and touchdown are smoothed away by the fit's priors.
     """
     z = joints[t0 : t1 + 1, joint_index("pelvis"), 2]
     if z.size < 3 or not np.isfinite(z).all():
         return True
-    v = np.diff(z) * fps
-    acc = (v[-1] - v[0]) / ((v.size - 1) / fps)
+    seconds = (z.size - 1) / fps
+    line = np.linspace(z[0], z[-1], z.size)
+    acc = -8.0 * float(np.max(z - line)) / seconds**2
     return bool(acc <= -BALLISTIC_FRACTION * GRAVITY_MS2)
 
 

@@ -46,3 +46,31 @@ def test_no_flight_in_walking():
     score = random_scores.random_score(np.random.default_rng(7), n_beats=8, travel=True)
     seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
     assert not any(s.is_air for s in seg.score.symbols)
+
+
+def _pelvis_track(z: np.ndarray) -> np.ndarray:
+    """(T, J, 3) joints with only the pelvis height set (what the flight test reads)."""
+    from capture2notation.body import JOINTS, joint_index
+
+    joints = np.zeros((len(z), len(JOINTS), 3))
+    joints[:, joint_index("pelvis"), 2] = z
+    return joints
+
+
+def test_a_fitted_flight_is_ballistic_by_its_rise_though_its_ends_are_smoothed():
+    from capture2notation.quantise.flight import _ballistic
+
+    fps, n = 25.0, 13  # a 0.48-s flight, take-off to touchdown
+    t = np.arange(n) / fps
+    free = 0.96 + 0.5 * 9.81 * t * (t[-1] - t)  # rises g D² / 8 = 0.28 m
+    # The fitted pelvis of a rendered jump through BlazePose (random score
+    # 20261401, frames 27-39): it rises 0.21 m, but the fit's temporal priors
+    # round off take-off and touchdown (1.2 and -0.65 m/s where the free fall
+    # has ±2.4), so the velocities alone say it falls at only 0.43 g.
+    fitted = np.array([0.962, 1.01, 1.084, 1.121, 1.158, 1.171, 1.158, 1.151, 1.138, 1.076, 1.025, 0.984, 0.958])
+    assert _ballistic(_pelvis_track(free), 0, n - 1, fps)
+    assert _ballistic(_pelvis_track(fitted), 0, n - 1, fps)
+    # Feet floating a few centimetres above a floor found low, the pelvis
+    # level or gliding: no flight.
+    assert not _ballistic(_pelvis_track(np.full(n, 0.95)), 0, n - 1, fps)
+    assert not _ballistic(_pelvis_track(np.linspace(0.9, 0.96, n)), 0, n - 1, fps)
