@@ -39,6 +39,7 @@ camera from the person.  Files lying beside the input are never read.
 
 from __future__ import annotations
 
+import concurrent.futures
 import json
 import logging
 import os
@@ -529,8 +530,16 @@ def notate(
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
     log.info("capture: tempo %s bpm%s", seg.tempo, how)
-    with _staging(outdir) as stage:
-        files, skipped = _write_outputs(stage, seg, motion, track, input_path, kind, overlay, (estimate, camera_source))
+    # Exit order: the overlay's thread is joined before the staging folder is moved or removed.
+    with _staging(outdir) as stage, concurrent.futures.ThreadPoolExecutor(max_workers=1) as side:
+        # The overlay (decode, draw, encode; OpenCV releases the GIL) is
+        # written beside the notation files and Effort, not after them.
+        drawing = None
+        if kind == "video" and overlay and track is not None:
+            from capture2notation.keypoints.overlay import write_overlay
+
+            drawing = side.submit(write_overlay, input_path, track, stage / "overlay.mp4", fps=track.fps)
+        files, skipped = _write_outputs(stage, seg, motion, track, kind, (estimate, camera_source))
         if extra_outputs is not None:
             files.update(extra_outputs(stage))
         if effort:
@@ -542,6 +551,8 @@ def notate(
                 skipped.append(f"effort.json: {exc}")
                 log.warning("capture: effort not estimated: %s", exc)
             seconds["effort"] = time.perf_counter() - t0
+        if drawing is not None:
+            files["overlay.mp4"] = drawing.result()
         staged = CaptureResult(
             outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped), how, estimate, camera_source
         )
@@ -577,9 +588,8 @@ def _staging(outdir: Path):
         shutil.rmtree(stage, ignore_errors=True)
 
 
-def _write_outputs(
-    outdir: Path, seg: Segmentation, motion, track, input_path, kind: str, overlay: bool, camera=(None, "")
-):
+def _write_outputs(outdir: Path, seg: Segmentation, motion, track, kind: str, camera=(None, "")):
+    """The notation files, the staff and ``capture.npz`` (the overlay is written beside them)."""
     from capture2notation.notation import write
     from capture2notation.notation.formats.laban_editor import write_laban_editor
     from capture2notation.notation.staff import render_staff
@@ -601,11 +611,7 @@ def _write_outputs(
     for page in sorted(outdir.glob("staff*.png")):
         files[page.name] = page
     files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track, *camera)
-    if kind == "video" and overlay and track is not None:
-        from capture2notation.keypoints.overlay import write_overlay
-
-        files["overlay.mp4"] = write_overlay(input_path, track, outdir / "overlay.mp4", fps=track.fps)
-    elif kind not in ("video", "multiview"):
+    if kind not in ("video", "multiview"):
         skipped.append(f"overlay.mp4: no video ({kind} input)")
     return files, skipped
 

@@ -122,8 +122,14 @@ def _log_sigma_integral(chi2: np.ndarray, a: np.ndarray) -> np.ndarray:
     u0 = chi2 * _HALF_INV_VAR[0]  # the small-σ end
     u1 = chi2 * _HALF_INV_VAR[1]
     p0, p1 = special.gammainc(a, u0), special.gammainc(a, u1)
-    if np.all(p0 > _TINY) and np.all(p1 < 0.5):  # the usual case: σ well inside the prior
-        return -a * np.log(chi2) + np.log(p0 - p1)
+    with np.errstate(divide="ignore"):
+        out = -a * np.log(chi2)
+    usual = (p0 > _TINY) & (p1 < 0.5)  # σ well inside the prior: the plain difference is accurate
+    out[usual] += np.log(p0[usual] - p1[usual])
+    if usual.all():
+        return out
+    rest = ~usual
+    a, u0, u1 = a[rest], u0[rest], u1[rest]
     lp0 = log_gammainc(a, u0)
     # P(a, u1) / P(a, u0) <= 1; when both are near 1 use the upper tails instead
     q1, q0 = special.gammaincc(a, u1), special.gammaincc(a, u0)
@@ -131,7 +137,14 @@ def _log_sigma_integral(chi2: np.ndarray, a: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = np.exp(log_gammainc(a, u1) - lp0)
         diff_log = np.where(near_one, np.log(np.maximum(q1 - q0, 0.0)), lp0 + np.log1p(-np.minimum(ratio, 1.0)))
-    return -a * np.log(chi2) + diff_log
+    out[rest] += diff_log
+    return out
+
+
+def _run_sums(lay: dict, *terms):
+    """Each (E,) term summed over the layout's (walker, movement) runs: one (n_combo,) array per term."""
+    starts = lay["run_starts"]
+    return tuple(np.add.reduceat(t, starts) for t in terms)
 
 
 class Batch:
@@ -265,24 +278,37 @@ class Batch:
                 r0 += k
                 c0 += k * sg.size
             rows, cols = np.concatenate(rows), np.concatenate(cols)
+            combo = np.concatenate(keys)
             lay = {
                 "rows": rows,
                 "logtau": self._logtau[cols],
                 "w": self._w[cols],
                 "ws": self._w[cols] * self._s[cols],
-                "key": np.concatenate(keys),
+                "key": combo,
                 "n_combo": c0,
+                # each (walker, movement) combo is one run of consecutive
+                # entries, in key order: sums over combos are np.add.reduceat
+                "run_starts": np.flatnonzero(np.r_[True, combo[1:] != combo[:-1]]),
                 "combo_row": np.concatenate(combo_row),
                 "combo_seg": np.concatenate(combo_seg),
                 "a": np.repeat(0.5 * self.dof[list(groups)], k),
+                # entries per θ row: rows are runs, so np.repeat(v, counts) is v[rows]
+                "counts": np.repeat([self._samples_of[g].size for g in groups], k),
             }
             if self.ar1:
                 sw, prev = np.sqrt(self._w), np.maximum(cols - 1, 0)
                 first = self._first[cols]
+                expo = self._expo[cols]
+                # φ = ρ one sampling step after the previous frame; after a
+                # gap (expo ≠ 1) φ = ρ^expo, computed for those entries only
+                irregular = np.flatnonzero(~first & (expo != 1.0))
                 lay.update(
-                    first=first,
-                    expo=self._expo[cols],
-                    odd=np.round(self._expo[cols]) % 2 == 1,
+                    first=np.flatnonzero(first),
+                    irregular=irregular,
+                    irr_expo=expo[irregular],
+                    irr_odd=np.round(expo[irregular]) % 2 == 1,
+                    irr_rows=rows[irregular],
+                    n_regular=np.bincount(rows, ~first & (expo == 1.0), r0),
                     sw=sw[cols],
                     sws=sw[cols] * self._s[cols],
                     sw_prev=np.where(first, 0.0, sw[prev]),
@@ -332,51 +358,57 @@ class Batch:
         k = theta.shape[0] // len(groups)
         lay = self._layout(groups, k, cache)
         b, lnx = theta[:, 0], np.log(theta[:, 1])
-        # progress() without its checks: s = (1 + x0^−b) / (1 + exp(b (ln τ − ln x0)))
-        amp = 1.0 + np.exp(-b * lnx)
-        br = b[lay["rows"]]
-        m = amp[lay["rows"]] / (1.0 + np.exp(br * lay["logtau"] - (b * lnx)[lay["rows"]]))
+        # progress() without its checks: s = (1 + x0^−b) / (1 + τ^b · x0^−b),
+        # per-row factors spread to the row's entries with np.repeat
+        e = np.exp(-b * lnx)
+        counts = lay["counts"]
+        m = np.repeat(1.0 + e, counts) / (1.0 + np.exp(np.repeat(b, counts) * lay["logtau"]) * np.repeat(e, counts))
         if self.ar1:
             return self._chi2_ar1(theta, lay, m)
         wm = lay["w"] * m
-        n_c, key = lay["n_combo"], lay["key"]
-        s_m = np.bincount(key, wm, n_c)
-        s_mm = np.bincount(key, wm * m, n_c)
-        s_sm = np.bincount(key, lay["ws"] * m, n_c)
+        s_m, s_mm, s_sm = _run_sums(lay, wm, wm * m, lay["ws"] * m)
         seg = lay["combo_seg"]
         return self._fit_ends(theta.shape[0], lay, self._s0[seg], self._ss[seg], self._sss[seg], s_m, s_mm, s_sm)
 
     def _chi2_ar1(self, theta, lay, m):
-        """:meth:`chi2` with AR(1) residuals: whiten data, offset basis and model, then as white."""
-        rows_of = lay["rows"]
-        rho = theta[:, 2][rows_of]
-        with np.errstate(divide="ignore", invalid="ignore"):  # ρ = 0; first frames are replaced below
-            phi = np.exp(lay["expo"] * np.log(np.abs(rho)))
-        # ρ < 0: the sign alternates frame by frame, so a gap of n frames has ρ^n
-        phi = np.where(lay["first"], 0.0, np.where((rho < 0) & lay["odd"], -phi, phi))
-        one_m_phi2 = 1.0 - phi * phi
-        c = 1.0 / np.sqrt(one_m_phi2)
+        """:meth:`chi2` with AR(1) residuals: whiten data, offset basis and model, then as white.
+
+        Each whitened entry is ``(x_i − φ_i x_{i−1}) / √(1 − φ_i²)``; the sums
+        below carry the factor ``1 / (1 − φ_i²)`` once instead of scaling
+        every whitened vector.
+        """
+        rows = theta.shape[0]
+        rho = theta[:, 2]
+        phi = np.repeat(rho, lay["counts"])
+        irr = lay["irregular"]
+        if irr.size:
+            # ρ < 0: the sign alternates frame by frame, so a gap of n frames has ρ^n
+            r = phi[irr]
+            p = np.abs(r) ** lay["irr_expo"]
+            phi[irr] = np.where((r < 0) & lay["irr_odd"], -p, p)
+        phi[lay["first"]] = 0.0  # a movement's first frame: nothing before it
+        inv = 1.0 / (1.0 - phi * phi)
+        # log det of the correlation matrix: Σ log(1 − φ²), per row
+        logdet_ar = lay["n_regular"] * np.log1p(-rho * rho)
+        if irr.size:
+            logdet_ar += np.bincount(lay["irr_rows"], np.log1p(-(phi[irr] ** 2)), rows)
         f = lay["sw"] * m
         # the entry before each one is the previous frame of the same movement
         # (entries are walker-major, movement by movement in time order); on a
         # movement's first frame φ = 0 and the wrapped value is not used
-        f_prev = np.empty_like(f)
-        f_prev[0], f_prev[1:] = 0.0, f[:-1]
-        ft = c * (f - phi * f_prev)
-        yt = c * (lay["sws"] - phi * lay["sws_prev"])
-        n_c, key, rows = lay["n_combo"], lay["key"], theta.shape[0]
-        s_m = None
+        df = f.copy()
+        df[1:] -= phi[1:] * f[:-1]
+        yd = lay["sws"] - phi * lay["sws_prev"]
+        iy = inv * yd
         if self.free_ends:
-            at = c * (lay["sw"] - phi * lay["sw_prev"])
-            s0, s_s = np.bincount(key, at * at, n_c), np.bincount(key, at * yt, n_c)
-            s_m = np.bincount(key, at * ft, n_c)
+            ad = lay["sw"] - phi * lay["sw_prev"]
+            ia = inv * ad
+            s_ss, s_sm, s_mm, s0, s_s, s_m = _run_sums(lay, iy * yd, iy * df, inv * df * df, ia * ad, ia * yd, ia * df)
         else:
-            s0 = s_s = None
-        s_ss = np.bincount(key, yt * yt, n_c)
-        s_mm = np.bincount(key, ft * ft, n_c)
-        s_sm = np.bincount(key, yt * ft, n_c)
+            s_ss, s_sm, s_mm = _run_sums(lay, iy * yd, iy * df, inv * df * df)
+            s0 = s_s = s_m = None
         chi2, logdet = self._fit_ends(rows, lay, s0, s_s, s_ss, s_m, s_mm, s_sm)
-        return chi2, logdet + np.bincount(rows_of, np.log(one_m_phi2), rows)
+        return chi2, logdet + logdet_ar
 
     def _fit_ends(self, rows, lay, s0, s_s, s_ss, s_m, s_mm, s_sm):
         """χ² at the best free ends (or pinned ends) from the per-(walker, movement) sums."""

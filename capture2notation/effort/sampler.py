@@ -13,7 +13,8 @@ Convergence is judged per group with emcee's integrated autocorrelation
 time (its ``autocorr.integrated_time`` estimator, vectorised over groups by
 :func:`integrated_time`).  The estimate costs a whole-chain FFT, so it is
 not redone every block: after each estimate a group is next checked when
-its chain reaches :data:`CHECK_AHEAD` × N_TAU × τ (then block by block), and
+its chain reaches :data:`CHECK_AHEAD` × N_TAU × τ (then each time it has
+grown by :data:`CHECK_STRIDE`), and
 a group whose τ asks for more than the step budget after
 :data:`GIVE_UP_MIN_STEPS` steps is given up (reported as such).  Chains are
 kept in preallocated arrays grown by doubling.  A group is done
@@ -31,14 +32,17 @@ from dataclasses import dataclass
 
 import emcee
 import numpy as np
+import scipy.fft
 
 from ..errors import EffortError
 from .likelihood import Batch
 
 __all__ = [
     "CHECK_AHEAD",
+    "CHECK_STRIDE",
     "GIVE_UP_FACTOR",
     "GIVE_UP_MIN_STEPS",
+    "MAX_DRAWS",
     "N_TAU",
     "Chain",
     "GroupedDEMove",
@@ -52,12 +56,23 @@ N_TAU = 50
 #: N_TAU times the last estimate (τ grows as the chain explores, and a check
 #: too late only costs a block): most checks need no FFT at all.
 CHECK_AHEAD = 0.8
+#: Once a chain is that long, τ is re-estimated each time the chain has
+#: grown by this fraction (at least a block): a converging chain is found at
+#: most this much late, and its τ estimates cost a few whole-chain FFTs
+#: instead of one per block.
+CHECK_STRIDE = 0.1
 #: Give up on a posterior whose chain needs more than this many times the
 #: step budget by its current τ estimate ...
 GIVE_UP_FACTOR = 1.0
 #: ... once it has run at least this many steps (shorter chains' τ
 #: estimates are too noisy to act on).
 GIVE_UP_MIN_STEPS = 1000
+#: Most draws a chain returns after burn-in and thinning.  A converged
+#: chain holds about W·steps/τ ≥ N_TAU·W = 800 effective draws (16 walkers);
+#: beyond a few thousand, further draws are correlated copies that move a
+#: 90 % interval by Monte Carlo noise only, yet every one costs a χ²
+#: evaluation when its ln σ is drawn.
+MAX_DRAWS = 2000
 #: Largest FFT work array of :func:`integrated_time`, elements.
 _FFT_CHUNK = 1 << 22
 
@@ -120,10 +135,6 @@ class GroupedDEMove(emcee.moves.Move):
         return state, accepted
 
 
-def _next_pow_two(n: int) -> int:
-    return 1 << max(int(n) - 1, 0).bit_length()
-
-
 def integrated_time(x, c: float = 5.0) -> np.ndarray:
     """emcee's integrated autocorrelation time estimate, per group and parameter.
 
@@ -146,12 +157,14 @@ def integrated_time(x, c: float = 5.0) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     n, G = x.shape[:2]
     out = np.empty((G, x.shape[3]))
-    m = 2 * _next_pow_two(n)
+    # zero padding to at least 2n makes the circular correlation linear;
+    # emcee pads to a power of two, a 5-smooth length is as exact and up to 2x shorter
+    m = scipy.fft.next_fast_len(2 * n, real=True)
     per_group = max(1, _FFT_CHUNK // (m * int(np.prod(x.shape[2:]))))
     for a in range(0, G, per_group):
         xs = x[:, a : a + per_group]
-        f = np.fft.rfft(xs - xs.mean(axis=0), n=m, axis=0)
-        acf = np.fft.irfft(f * np.conj(f), n=m, axis=0)[:n]
+        f = scipy.fft.rfft(xs - xs.mean(axis=0), n=m, axis=0)
+        acf = scipy.fft.irfft(f * np.conj(f), n=m, axis=0)[:n]
         with np.errstate(divide="ignore", invalid="ignore"):
             acf = acf / acf[0]
         taus = 2.0 * np.cumsum(acf.mean(axis=2), axis=0) - 1.0  # (n, g, ndim)
@@ -191,12 +204,13 @@ class Chain:
         return int(self.chain.shape[0])
 
     def samples(self) -> np.ndarray:
-        """(M, ndim) after burn-in 2·max τ and thinning by min τ / 2 (emcee's tutorial)."""
+        """(M, ndim) after burn-in 2·max τ and thinning by min τ / 2 (emcee's tutorial), M ≤ MAX_DRAWS."""
         tau = self.tau[np.isfinite(self.tau) & (self.tau > 0)]
         tmax = float(tau.max()) if tau.size else self.steps / N_TAU
         tmin = float(tau.min()) if tau.size else 1.0
         burn = min(int(2 * tmax), self.steps // 2)
-        thin = max(1, int(0.5 * tmin))
+        walkers = self.chain.shape[1]
+        thin = max(1, int(0.5 * tmin), -(-(self.steps - burn) * walkers // MAX_DRAWS))
         return self.chain[burn::thin].reshape(-1, self.chain.shape[-1])
 
 
@@ -320,11 +334,13 @@ def run_groups(
                 old_tau[g] = t
                 # next estimate: the next block when the chain is long enough
                 # already (τ must also be stable), else once it nears 50 τ
-                next_check[g] = (
-                    steps + block
-                    if steps >= CHECK_AHEAD * need
-                    else max(steps + block, int(CHECK_AHEAD * need) // block * block)
-                )
+                # then every CHECK_STRIDE of the chain's length, so that the
+                # FFTs of a long chain cost a bounded multiple of one
+                soon = steps + max(block, -(-int(CHECK_STRIDE * steps) // block) * block)
+                ahead = CHECK_AHEAD * need
+                # (no finite τ yet, e.g. a walker that never moved: look again soon)
+                late = np.isfinite(ahead) and steps < ahead
+                next_check[g] = max(soon, int(ahead) // block * block) if late else soon
         keep = np.flatnonzero(~finished)
         coords = state.coords.reshape(n_a, W, D)[keep].reshape(-1, D)
         logp = state.log_prob.reshape(n_a, W)[keep].ravel()

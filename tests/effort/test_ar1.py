@@ -143,3 +143,31 @@ def test_the_capture_prior_of_rho_covers_smooth_noise_of_short_movements():
 def test_rho_range_is_checked():
     with pytest.raises(EffortError, match="rho_range"):
         Batch([(TAU, TAU, None, None)], ar1=True, rho_range=(0.5, 1.0))
+
+
+def test_every_row_of_a_batch_on_an_irregular_grid_equals_the_dense_gaussian():
+    # bin-averaged curves (high frame rates) have uneven steps: most entries
+    # then take φ = ρ^(Δτ/δ), the rest φ = ρ; several posteriors and several
+    # walkers per posterior, each row with its own ρ
+    rng = np.random.default_rng(8)
+    grids = [np.sort(rng.uniform(0.02, 0.98, n)) for n in (17, 30, 9)]
+    data = [
+        (t, progress(t, -2.6, 0.5) + 0.02 * rng.standard_normal(t.size), rng.uniform(0.5, 1, t.size)) for t in grids
+    ]
+    batch = Batch([(t, s, w, None) for t, s, w in data], ar1=True)
+    theta = np.array(
+        [
+            [-2.5, 0.52, 0.9],
+            [-3.1, 0.47, 0.35],
+            [-2.0, 0.6, 0.7],
+            [-4.0, 0.4, 0.05],
+            [-2.7, 0.5, 0.97],
+            [-1.8, 0.7, 0.5],
+        ]
+    )
+    chi2, logdet = batch.chi2(theta)  # two rows per posterior, group-major
+    for i, th in enumerate(theta):
+        t, s, w = data[i // 2]
+        want_chi2, want_logdet = _dense(th, t, s, w, True)
+        assert chi2[i] == pytest.approx(want_chi2, rel=1e-7)
+        assert logdet[i] == pytest.approx(want_logdet, rel=1e-7, abs=1e-7)

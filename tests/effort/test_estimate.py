@@ -145,3 +145,19 @@ def test_a_long_clip_in_passages_keeps_the_phrase_effort():
     data = parts.to_dict()
     assert len(data["passages"]) == len(parts.passages)
     assert data["passages"][0]["start_s"] < data["passages"][-1]["start_s"]
+
+
+def test_chunks_share_the_work_evenly_whatever_the_job_order(monkeypatch):
+    # one large pooled set and many small movements: the pooled set gets a
+    # chunk's worth of work to itself, not a round-robin share of movements on top
+    from capture2notation.effort import estimate as est
+
+    seen = []
+    monkeypatch.setattr(
+        est, "_sample_job", lambda args: seen.append([len(d[0]) for d in args[0]]) or [None] * len(args[0])
+    )
+    jobs = [(np.zeros(20),)] * 11 + [(np.zeros(200),)]
+    out = est._sample_all(jobs, np.random.default_rng(0), 1, {}, chunk=6)
+    assert len(out) == 12 and len(seen) == 2
+    loads = sorted(sum(c) for c in seen)
+    assert loads == [200, 220]  # round-robin would give 120 and 300

@@ -108,3 +108,25 @@ def test_bad_input_names_the_posterior():
         Batch([])
     with pytest.raises(EffortError, match="theta"):
         Batch([(TAU, TAU, None, None)]).log_marginal(np.zeros((3, 3)))
+
+
+def test_sigma_integral_of_rows_in_every_regime_equals_each_row_alone():
+    # a batch mixing rows whose σ sits well inside the prior with rows below
+    # its lower end (a near-perfect fit) and above its upper end: each row's
+    # value must not depend on which other rows share the call
+    from capture2notation.effort.likelihood import _log_sigma_integral
+
+    a = np.full(5, 11.0)
+    chi2 = np.array([0.05, 1e-9, 3e-300, 40.0, 0.3])
+    together = _log_sigma_integral(chi2, a)
+    alone = np.array([_log_sigma_integral(chi2[i : i + 1], a[i : i + 1])[0] for i in range(chi2.size)])
+    np.testing.assert_allclose(together, alone, rtol=1e-12)
+    # the integral itself, by quadrature over ln σ (a = 11, χ² = 0.05 and 40),
+    # up to the per-a constant ½ Γ(a) 2^a that the sampler drops
+    const = np.log(0.5) + special.gammaln(a[0]) + a[0] * np.log(2.0)
+    for i in (0, 3):
+        lns = np.linspace(*LOG_SIGMA_RANGE, 400_001)
+        f = -2 * a[i] * lns - chi2[i] / (2 * np.exp(2 * lns))
+        top = f.max()  # trapezoid rule: the integrand of χ² = 40 peaks at the prior's end
+        want = top + np.log(np.trapezoid(np.exp(f - top), lns))
+        assert together[i] + const == pytest.approx(want, abs=1e-4)

@@ -6,7 +6,10 @@ import pytest
 
 from capture2notation.effort.likelihood import Batch
 from capture2notation.effort.sampler import (
+    CHECK_STRIDE,
+    MAX_DRAWS,
     N_TAU,
+    Chain,
     GroupedDEMove,
     integrated_time,
     run_groups,
@@ -108,3 +111,42 @@ def test_a_posterior_with_no_sound_starting_walker_is_refused_by_name():
     batch.log_marginal = second_group_impossible
     with pytest.raises(EffortError, match=r"posteriors \[1\]: every starting walker"):
         run_groups(batch, [(-2.5, 0.5), (-3.0, 0.4)], np.full((2, 2), 0.01), np.random.default_rng(1))
+
+
+def test_a_long_chain_returns_at_most_max_draws_spread_over_all_of_it():
+    steps, W = 6000, 16
+    chain = np.arange(steps, dtype=float)[:, None, None] * np.ones((1, W, 2))
+    ch = Chain(chain, tau=np.array([4.0, 6.0]), acceptance=0.3, converged=True)
+    smp = ch.samples()
+    assert smp.shape[0] <= MAX_DRAWS and smp.shape[0] > 0.9 * MAX_DRAWS
+    # burn-in 2·max τ = 12 steps, then evenly through to the chain's end
+    assert smp[:, 0].min() == 12 and smp[:, 0].max() > steps - 60
+    short = Chain(chain[:200], tau=np.array([4.0, 6.0]), acceptance=0.3, converged=True).samples()
+    assert short.shape[0] == (200 - 12) // 2 * W  # short chains keep emcee's thinning by τ_min / 2
+
+
+def test_convergence_is_checked_at_most_every_stride_of_the_chain_once_it_is_long():
+    # a chain whose τ keeps growing with it (never 50 τ long) is re-estimated
+    # about log(steps)/log(1 + stride) times, not once per block
+    from capture2notation.effort import sampler
+
+    batch = _batch([(-2.5, 0.5)])
+    calls = []
+    plain = sampler.integrated_time
+
+    def counting(x, c=5.0):
+        calls.append(x.shape[0])
+        return np.full((x.shape[1], x.shape[3]), x.shape[0] / 40.0)  # needs 1.25x its length
+
+    sampler.integrated_time = counting
+    try:
+        (ch,) = sampler.run_groups(
+            batch, [(-2.5, 0.5)], [(0.01, 0.002)], np.random.default_rng(0), block=10, max_steps=2000
+        )
+    finally:
+        sampler.integrated_time = plain
+    assert not ch.converged and ch.stop == "gave up"
+    assert calls[-1] > 1000  # given up once 50 τ exceeded the budget, after the minimum
+    gaps = np.diff(calls)
+    assert np.all(gaps >= np.maximum(10, np.floor(CHECK_STRIDE * np.array(calls[:-1]))))
+    assert len(calls) < np.log(calls[-1] / 10) / np.log(1 + CHECK_STRIDE) + 5  # per block: > 100
