@@ -57,7 +57,7 @@ from scipy import special
 from ..errors import EffortError
 from ..notation.effort import TIME_RANGE, WEIGHT_RANGE
 
-__all__ = ["CAPTURE_RHO_RANGE", "LOG_SIGMA_RANGE", "RHO_RANGE", "Batch", "log_gammainc"]
+__all__ = ["CAPTURE_RHO_RANGE", "LOG_SIGMA_RANGE", "RHO_RANGE", "Batch", "log_gammainc", "log_gammaincc"]
 
 #: Uniform prior bounds of ln σ (σ from 1e-4 to 0.5 in units of progress).
 LOG_SIGMA_RANGE = (np.log(1e-4), np.log(0.5))
@@ -132,12 +132,63 @@ def _log_sigma_integral(chi2: np.ndarray, a: np.ndarray) -> np.ndarray:
     a, u0, u1 = a[rest], u0[rest], u1[rest]
     lp0 = log_gammainc(a, u0)
     # P(a, u1) / P(a, u0) <= 1; when both are near 1 use the upper tails instead
-    q1, q0 = special.gammaincc(a, u1), special.gammaincc(a, u0)
-    near_one = q1 < 0.5
+    near_one = special.gammaincc(a, u1) < 0.5
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = np.exp(log_gammainc(a, u1) - lp0)
-        diff_log = np.where(near_one, np.log(np.maximum(q1 - q0, 0.0)), lp0 + np.log1p(-np.minimum(ratio, 1.0)))
+        diff_log = lp0 + np.log1p(-np.minimum(ratio, 1.0))
+        # a fit far worse than σ's upper end allows: Q(a, u1) − Q(a, u0) in
+        # logs, where both may underflow (finite, so the sampler is led back)
+        lq1, lq0 = log_gammaincc(a[near_one], u1[near_one]), log_gammaincc(a[near_one], u0[near_one])
+        diff_log[near_one] = lq1 + np.log1p(-np.exp(np.minimum(lq0 - lq1, 0.0)))
     out[rest] += diff_log
+    return out
+
+
+#: Terms of the continued fraction of :func:`log_gammaincc` (it converges
+#: within a few dozen where it is used, x > a + 1).
+_CF_TERMS = 200
+
+
+def log_gammaincc(a, x):
+    """log Q(a, x), the regularised upper incomplete gamma function, without underflow.
+
+    Parameters
+    ----------
+    a, x : array_like
+        Shape (> 0) and argument (≥ 0), broadcast together.
+
+    Returns
+    -------
+    ndarray
+        ``log Q(a, x)``; where Q underflows (x far above a) from the continued
+        fraction ``Q = e^−x x^a / Γ(a) · 1/(x + 1 − a − 1·(1 − a)/(x + 3 − a − …))``
+        evaluated by Lentz's method (Numerical Recipes, ``gcf``).
+    """
+    a, x = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(x, dtype=float))
+    q = special.gammaincc(a, x)
+    out = np.empty(a.shape)
+    big = q > _TINY
+    out[big] = np.log(q[big])
+    if not big.all():
+        aa, xx = a[~big], x[~big]  # underflow needs x > a + 1: the fraction converges
+        tiny = 1e-300
+        b = xx + 1.0 - aa
+        c = np.full_like(xx, 1.0 / tiny)
+        d = 1.0 / b
+        h = d.copy()
+        for i in range(1, _CF_TERMS):
+            an = -i * (i - aa)
+            b = b + 2.0
+            d = an * d + b
+            d = np.where(np.abs(d) < tiny, tiny, d)
+            c = b + an / c
+            c = np.where(np.abs(c) < tiny, tiny, c)
+            d = 1.0 / d
+            step = d * c
+            h = h * step
+            if np.all(np.abs(step - 1.0) < 1e-15):
+                break
+        out[~big] = -xx + aa * np.log(xx) - special.gammaln(aa) + np.log(h)
     return out
 
 

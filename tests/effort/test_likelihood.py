@@ -130,3 +130,32 @@ def test_sigma_integral_of_rows_in_every_regime_equals_each_row_alone():
         top = f.max()  # trapezoid rule: the integrand of χ² = 40 peaks at the prior's end
         want = top + np.log(np.trapezoid(np.exp(f - top), lns))
         assert together[i] + const == pytest.approx(want, abs=1e-4)
+
+
+def test_log_gammaincc_matches_scipy_and_does_not_underflow():
+    from capture2notation.effort.likelihood import log_gammaincc
+
+    a = np.array([5.0, 50.0, 1200.0])
+    x = np.array([20.0, 90.0, 1500.0])
+    np.testing.assert_allclose(log_gammaincc(a, x), np.log(special.gammaincc(a, x)), rtol=1e-12)
+    # below 1e-280 the continued fraction is used: against scipy where it still has a value ...
+    assert log_gammaincc(1200.0, 3000.0) == pytest.approx(np.log(special.gammaincc(1200.0, 3000.0)), rel=1e-9)
+    # ... and against a log-space quadrature where scipy underflows
+    assert special.gammaincc(1200.0, 3500.0) == 0.0
+    t = np.linspace(3500.0, 3900.0, 2_000_001)
+    logf = 1199.0 * np.log(t) - t
+    top = logf.max()
+    want = top + np.log(np.trapezoid(np.exp(logf - top), t)) - special.gammaln(1200.0)
+    assert log_gammaincc(1200.0, 3500.0) == pytest.approx(want, rel=1e-7)
+    # far out: the leading term e^−x x^(a−1) / Γ(a)
+    assert log_gammaincc(11.0, 1e5) == pytest.approx(-1e5 + 10 * np.log(1e5) - special.gammaln(11.0), abs=1e-3)
+
+
+def test_a_fit_far_worse_than_the_largest_sigma_keeps_a_finite_density():
+    # garbage progress (a mis-fitted limb) must not leave every walker at
+    # zero probability: the density falls off, finitely, towards worse fits
+    tau = np.arange(1, 12) / 12
+    s = np.array([0.2, 0.0, -2.0, -0.6, -0.8, -15.0, -37.5, -37.7, -6.7, -9.4, 4.4])
+    batch = Batch([(tau, s, None, None)], ar1=True)
+    lp = batch.log_marginal(np.array([[-3.0, 0.5, r] for r in (-0.4, 0.0, 0.5, 0.9)]))
+    assert np.all(np.isfinite(lp))
