@@ -36,6 +36,7 @@ import argparse
 import dataclasses
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -143,6 +144,10 @@ def bench_video(seconds: float, workers: int, workdir: Path) -> None:
     print(
         f"| {m['wall']:.1f} | {m['wall'] / duration:.2f} | {m['cpu']:.1f} | {m['rss_mb']:.0f} MB | {m['worker_mb']:.0f} MB |"
     )
+    # the capture's own stage timings, as its page shows them
+    stages = re.search(r"keypoints [0-9.]+ s[^<]*", (out / "index.html").read_text(encoding="utf-8"))
+    if stages:
+        print(f"\nstages (wall): {stages.group(0)}")
 
 
 def bench_minutes(minutes, effort: bool, workers: int, workdir: Path) -> None:

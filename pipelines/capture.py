@@ -539,7 +539,9 @@ def notate(
             from capture2notation.keypoints.overlay import write_overlay
 
             drawing = side.submit(write_overlay, input_path, track, stage / "overlay.mp4", fps=track.fps)
+        t0 = time.perf_counter()
         files, skipped = _write_outputs(stage, seg, motion, track, kind, (estimate, camera_source))
+        seconds["outputs"] = time.perf_counter() - t0
         if extra_outputs is not None:
             files.update(extra_outputs(stage))
         if effort:
@@ -552,7 +554,9 @@ def notate(
                 log.warning("capture: effort not estimated: %s", exc)
             seconds["effort"] = time.perf_counter() - t0
         if drawing is not None:
+            t0 = time.perf_counter()
             files["overlay.mp4"] = drawing.result()
+            seconds["overlay (after the rest)"] = time.perf_counter() - t0
         staged = CaptureResult(
             outdir, kind, seg.score, seg, motion, track, files, seconds, tuple(skipped), how, estimate, camera_source
         )

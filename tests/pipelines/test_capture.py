@@ -516,3 +516,22 @@ def test_squats_stand_on_both_feet(fixture_path, tmp_path):
     # Low and middle alternate: each squat is one low support.
     assert all(a != b for a, b in itertools.pairwise(levels)), levels
     assert not [s for s in res.score.symbols if s.part.endswith("_leg")]
+
+
+def test_an_overlay_that_fails_beside_the_notation_fails_the_capture_and_leaves_nothing(
+    marker_render, tmp_path, monkeypatch
+):
+    # the overlay is written in a thread while the notation files are made:
+    # its error must still reach the caller, after the thread is joined, and
+    # the staging folder must go
+    from capture2notation.errors import KeypointError
+    from capture2notation.keypoints import overlay
+
+    def broken(video, track, out, fps=None):
+        raise KeypointError(f"{video}: frame 3 is 10x10, the track was made on 640x480")
+
+    monkeypatch.setattr(overlay, "write_overlay", broken)
+    with pytest.raises(KeypointError, match="frame 3"):
+        capture(marker_render / "video.mp4", tmp_path / "c", backend="markers", tempo=90, progress=False, effort=False)
+    assert not (tmp_path / "c").exists()
+    assert not list(tmp_path.glob(".c.partial-*"))
