@@ -108,7 +108,10 @@ HANG_S = 120
 
 def _start(tmp_path):
     (tmp_path / "study.toml").write_text(SIGNAL_STUDY)
-    cmd = [sys.executable, "-c", "from pipelines.cli import main; main()", "fidelity-study"]
+    # Ctrl-C live as in a terminal: a shell's background job (CI run with `&`)
+    # passes SIGINT on ignored, and Python then never raises KeyboardInterrupt
+    live = "import signal; signal.signal(signal.SIGINT, signal.default_int_handler)"
+    cmd = [sys.executable, "-c", f"{live}; from pipelines.cli import main; main()", "fidelity-study"]
     cmd += ["--config", str(tmp_path / "study.toml"), "--workers", "2", "-o", str(tmp_path / "out")]
     # A session of its own, as a terminal's job: Ctrl-C reaches its whole process group.
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
