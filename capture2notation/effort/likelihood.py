@@ -84,6 +84,31 @@ _TINY = 1e-280
 _HALF_INV_VAR = 0.5 * np.exp(-2.0 * np.asarray(LOG_SIGMA_RANGE))
 
 
+def _log_regularised(value, tail, a, x):
+    """log of `value(a, x)` (scipy's P or Q), with ``tail(a, x)`` where the value is below :data:`_TINY`."""
+    a, x = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(x, dtype=float))
+    v = value(a, x)
+    out = np.empty(a.shape)
+    big = v > _TINY
+    out[big] = np.log(v[big])
+    if not big.all():
+        out[~big] = tail(a[~big], x[~big])
+    return out
+
+
+def _log_lower_series(a, x):
+    """log P(a, x) from its series, for x below a (where P underflows)."""
+    with np.errstate(divide="ignore"):
+        lead = a * np.log(x) - x - special.gammaln(a + 1.0)
+    # underflow needs x < a, so the terms shrink at least geometrically
+    term = np.ones_like(x)
+    total = np.ones_like(x)
+    for k in range(1, 80):
+        term = term * x / (a + k)
+        total += term
+    return lead + np.log(total)
+
+
 def log_gammainc(a, x):
     """log P(a, x), the regularised lower incomplete gamma function, without underflow.
 
@@ -98,23 +123,7 @@ def log_gammainc(a, x):
         ``log P(a, x)``; where P underflows (x far below a) the series
         ``P = x^a e^−x / Γ(a+1) · Σ_k x^k / ((a+1)…(a+k))`` is summed in logs.
     """
-    a, x = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(x, dtype=float))
-    p = special.gammainc(a, x)
-    out = np.empty(a.shape)
-    big = p > _TINY
-    out[big] = np.log(p[big])
-    if not big.all():
-        aa, xx = a[~big], x[~big]
-        with np.errstate(divide="ignore"):
-            lead = aa * np.log(xx) - xx - special.gammaln(aa + 1.0)
-        # underflow needs x < a, so the terms shrink at least geometrically
-        term = np.ones_like(xx)
-        total = np.ones_like(xx)
-        for k in range(1, 80):
-            term = term * xx / (aa + k)
-            total += term
-        out[~big] = lead + np.log(total)
-    return out
+    return _log_regularised(special.gammainc, _log_lower_series, a, x)
 
 
 def _log_sigma_integral(chi2: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -149,6 +158,28 @@ def _log_sigma_integral(chi2: np.ndarray, a: np.ndarray) -> np.ndarray:
 _CF_TERMS = 200
 
 
+def _log_upper_fraction(a, x):
+    """log Q(a, x) from its continued fraction by Lentz's method, for x > a + 1 (where Q underflows)."""
+    tiny = 1e-300
+    b = x + 1.0 - a
+    c = np.full_like(x, 1.0 / tiny)
+    d = 1.0 / b
+    h = d.copy()
+    for i in range(1, _CF_TERMS):
+        an = -i * (i - a)
+        b = b + 2.0
+        d = an * d + b
+        d = np.where(np.abs(d) < tiny, tiny, d)
+        c = b + an / c
+        c = np.where(np.abs(c) < tiny, tiny, c)
+        d = 1.0 / d
+        step = d * c
+        h = h * step
+        if np.all(np.abs(step - 1.0) < 1e-15):
+            break
+    return -x + a * np.log(x) - special.gammaln(a) + np.log(h)
+
+
 def log_gammaincc(a, x):
     """log Q(a, x), the regularised upper incomplete gamma function, without underflow.
 
@@ -164,36 +195,11 @@ def log_gammaincc(a, x):
         fraction ``Q = e^−x x^a / Γ(a) · 1/(x + 1 − a − 1·(1 − a)/(x + 3 − a − …))``
         evaluated by Lentz's method (Numerical Recipes, ``gcf``).
     """
-    a, x = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(x, dtype=float))
-    q = special.gammaincc(a, x)
-    out = np.empty(a.shape)
-    big = q > _TINY
-    out[big] = np.log(q[big])
-    if not big.all():
-        aa, xx = a[~big], x[~big]  # underflow needs x > a + 1: the fraction converges
-        tiny = 1e-300
-        b = xx + 1.0 - aa
-        c = np.full_like(xx, 1.0 / tiny)
-        d = 1.0 / b
-        h = d.copy()
-        for i in range(1, _CF_TERMS):
-            an = -i * (i - aa)
-            b = b + 2.0
-            d = an * d + b
-            d = np.where(np.abs(d) < tiny, tiny, d)
-            c = b + an / c
-            c = np.where(np.abs(c) < tiny, tiny, c)
-            d = 1.0 / d
-            step = d * c
-            h = h * step
-            if np.all(np.abs(step - 1.0) < 1e-15):
-                break
-        out[~big] = -xx + aa * np.log(xx) - special.gammaln(aa) + np.log(h)
-    return out
+    return _log_regularised(special.gammaincc, _log_upper_fraction, a, x)
 
 
 def _run_sums(lay: dict, *terms):
-    """Each (E,) term summed over the layout's (walker, movement) runs: one (n_combo,) array per term."""
+    """Each (E,) term summed over the layout's (walker, movement) runs: one (combos,) array per term."""
     starts = lay["run_starts"]
     return tuple(np.add.reduceat(t, starts) for t in terms)
 
@@ -331,12 +337,9 @@ class Batch:
             rows, cols = np.concatenate(rows), np.concatenate(cols)
             combo = np.concatenate(keys)
             lay = {
-                "rows": rows,
                 "logtau": self._logtau[cols],
                 "w": self._w[cols],
                 "ws": self._w[cols] * self._s[cols],
-                "key": combo,
-                "n_combo": c0,
                 # each (walker, movement) combo is one run of consecutive
                 # entries, in key order: sums over combos are np.add.reduceat
                 "run_starts": np.flatnonzero(np.r_[True, combo[1:] != combo[:-1]]),

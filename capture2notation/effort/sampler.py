@@ -332,10 +332,9 @@ def run_groups(
                     del store[g]
                     finished[j] = True
                 old_tau[g] = t
-                # next estimate: the next block when the chain is long enough
-                # already (τ must also be stable), else once it nears 50 τ
-                # then every CHECK_STRIDE of the chain's length, so that the
-                # FFTs of a long chain cost a bounded multiple of one
+                # next estimate: once the chain nears 50 τ, and from then on
+                # each time it has grown by CHECK_STRIDE (at least a block),
+                # so that the FFTs of a long chain cost a bounded multiple of one
                 soon = steps + max(block, -(-int(CHECK_STRIDE * steps) // block) * block)
                 ahead = CHECK_AHEAD * need
                 # (no finite τ yet, e.g. a walker that never moved: look again soon)
