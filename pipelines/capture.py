@@ -194,11 +194,14 @@ def load_motion(
     flip_test: bool = False,
     calibration=None,
     floor: float | None = None,
+    threads: int = 2,
 ):
     """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
 
     Parameters
     ----------
+    threads : int
+        The pose model's onnxruntime threads.
     calibration : str or Path, optional
         A calibration file (DESIGN.md, "Cameras and calibration files") with
         the video's camera; without it the fit estimates the camera from the
@@ -231,7 +234,9 @@ def load_motion(
             if fps_override is not None:
                 track = replace(track, fps=float(fps_override), times=np.arange(len(track)) / float(fps_override))
         else:
-            track = extract(path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test)
+            track = extract(
+                path, backend=backend, fps=fps_override, progress=progress, flip_test=flip_test, threads=threads
+            )
         seconds["keypoints"] = time.perf_counter() - t0
         camera, pinhole = None, track
         if known is not None:
@@ -322,6 +327,7 @@ def capture(
     floor: float | None = None,
     offsets=None,
     workers: int = 1,
+    threads: int = 2,
 ) -> CaptureResult:
     """Capture notation from a video or motion file, or from clips of several calibrated cameras.
 
@@ -354,6 +360,9 @@ def capture(
     workers : int
         Processes sampling the Effort posteriors (the results do not
         depend on it).
+    threads : int
+        The pose model's onnxruntime threads (1 where several captures run
+        side by side on few cores).
     overlay : bool
         Write ``overlay.mp4`` for video input.
     flip_test : bool
@@ -402,8 +411,9 @@ def capture(
     kind = input_kind(input_path)
     outdir = Path(outdir)
     motion, track, seconds = load_motion(
-        input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration, floor=floor
-    )
+        input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration, floor=floor,
+        threads=threads,
+    )  # fmt: skip
     estimate, camera_source = None, ""
     if track is not None:
         from capture2notation.fitting.camera_estimate import estimate_camera

@@ -53,6 +53,12 @@ FLOOR_SIGMA_M = 0.03
 AXIS_SIGMA_DEG = 6.0
 #: Horizontal fields of view searched, degrees (phones: 50-80; margin both ways).
 HFOV_RANGE_DEG = (30.0, 110.0)
+#: Focal lengths tried, log-spaced over HFOV_RANGE_DEG (0.9 % apart; a
+#: parabola through the best three refines far below the estimate's spread).
+FOCAL_GRID = 193
+#: Focal lengths whose frame costs are computed at once (bounds the working
+#: array to FOCAL_CHUNK × MAX_FRAMES × 33 × 3 floats, 19 MB).
+FOCAL_CHUNK = 40
 #: Bootstrap resamples of frame blocks for the focal length's spread.
 BOOTSTRAP = 24
 #: Frames per bootstrap block (about a second at 25 fps: errors persist that long).
@@ -151,51 +157,82 @@ def pitch_roll(R) -> tuple[float, float]:
     return float(np.degrees(np.arcsin(np.clip(u[2], -1, 1)))), float(np.degrees(np.arctan2(-u[0], -u[1])))
 
 
-def _translations(f: float, uv: np.ndarray, W: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """(T, 3) per-frame translations for focal `f`: the linear least squares of the projection.
+def _moments(uv: np.ndarray, W: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(T, 10) per-frame weighted sums from which every focal length's translations follow.
 
-    ``f Tx − x Tz = x Wz − f Wx`` and ``f Ty − y Tz = y Wz − f Wy`` per
-    landmark (x, y centred pixels), weighted by `w` (T, K).
+    The projection's normal equations (:func:`_translations`) are polynomials
+    in ``f`` whose coefficients are these sums over the landmarks, so a
+    focal search costs one pass over the landmarks, not one per candidate.
     """
     x, y = uv[..., 0], uv[..., 1]
-    T_, K_ = x.shape
-    A = np.zeros((T_, K_, 2, 3))
-    A[..., 0, 0] = f
-    A[..., 0, 2] = -x
-    A[..., 1, 1] = f
-    A[..., 1, 2] = -y
-    b = np.stack([x * W[..., 2] - f * W[..., 0], y * W[..., 2] - f * W[..., 1]], -1)
-    A = A.reshape(T_, 2 * K_, 3)
-    b = b.reshape(T_, 2 * K_)
-    ww = np.repeat(w, 2, axis=1)
-    AtA = np.einsum("tki,tk,tkj->tij", A, ww, A) + 1e-9 * np.eye(3)
-    Atb = np.einsum("tki,tk,tk->ti", A, ww, b)
-    return np.linalg.solve(AtA, Atb[..., None])[..., 0]
+    r2 = x * x + y * y
+    terms = (1.0, x, y, r2, x * W[..., 2], W[..., 0], y * W[..., 2], W[..., 1], r2 * W[..., 2])
+    terms += (x * W[..., 0] + y * W[..., 1],)
+    return np.stack([np.sum(w * t, axis=1) for t in terms], axis=-1)
 
 
-def _reprojection_cost(f: float, uv, W, w) -> float:
-    T = _translations(f, uv, W, w)
-    P = W + T[:, None]
-    z = np.where(P[..., 2] > 1e-3, P[..., 2], np.nan)
-    r = np.hypot(f * P[..., 0] / z - uv[..., 0], f * P[..., 1] / z - uv[..., 1]) / PIXEL_SIGMA
-    return float(np.nansum(w * np.log1p(np.where(np.isfinite(r), r, 1e3) ** 2)))
+def _translations(f, m: np.ndarray) -> np.ndarray:
+    """Per-frame translations for focal length(s) `f`: the weighted linear least squares of the projection.
+
+    Each landmark (x, y centred pixels, weight w) gives ``f Tx − x Tz = x Wz − f Wx``
+    and ``f Ty − y Tz = y Wz − f Wy``.
+
+    Parameters
+    ----------
+    f : float or (F,) ndarray
+        Focal length(s), pixels.
+    m : (T, 10) ndarray
+        :func:`_moments` of the frames.
+
+    Returns
+    -------
+    (T, 3) or (F, T, 3) ndarray
+        Metres, camera axes.
+    """
+    f = np.asarray(f, float)[..., None]  # (F, 1) or (1,)
+    s0, sx, sy, sr, xwz, wx, ywz, wy, rwz, xy_w = np.moveaxis(m, -1, 0)
+    A = np.zeros(np.broadcast_shapes(f.shape, s0.shape) + (3, 3))
+    A[..., 0, 0] = A[..., 1, 1] = f * f * s0
+    A[..., 0, 2] = A[..., 2, 0] = -f * sx
+    A[..., 1, 2] = A[..., 2, 1] = -f * sy
+    A[..., 2, 2] = sr
+    A += 1e-9 * np.eye(3)
+    b = np.stack([f * xwz - f * f * wx, f * ywz - f * f * wy, f * xy_w - rwz], -1)
+    return np.linalg.solve(A, b[..., None])[..., 0]
 
 
-def _best_focal(uv, W, w, width: float) -> tuple[float, bool]:
-    """The focal length of least robust reprojection cost, and whether it lies inside the searched range."""
+def _frame_costs(focals: np.ndarray, uv, W, w, m) -> np.ndarray:
+    """(F, T) robust reprojection cost of each frame at each focal length (Cauchy, scale :data:`PIXEL_SIGMA`)."""
+    out = np.empty((len(focals), len(uv)))
+    for i in range(0, len(focals), FOCAL_CHUNK):
+        f = focals[i : i + FOCAL_CHUNK, None, None]
+        P = W + _translations(focals[i : i + FOCAL_CHUNK], m)[:, :, None]  # (F, T, K, 3)
+        z = np.where(P[..., 2] > 1e-3, P[..., 2], np.nan)
+        r = np.hypot(f * P[..., 0] / z - uv[..., 0], f * P[..., 1] / z - uv[..., 1]) / PIXEL_SIGMA
+        out[i : i + FOCAL_CHUNK] = np.sum(w * np.log1p(np.where(np.isfinite(r), r, 1e3) ** 2), axis=-1)
+    return out
+
+
+def _focal_grid(width: float) -> np.ndarray:
+    """Candidate focal lengths (pixels), log-spaced over :data:`HFOV_RANGE_DEG`."""
     lo, hi = (0.5 * width / np.tan(np.radians(a) / 2) for a in HFOV_RANGE_DEG[::-1])
-    grid = np.geomspace(lo, hi, 33)
-    costs = np.array([_reprojection_cost(f, uv, W, w) for f in grid])
+    return np.geomspace(lo, hi, FOCAL_GRID)
+
+
+def _best_focal(grid: np.ndarray, costs: np.ndarray) -> tuple[float, bool]:
+    """The focal length of least cost, and whether it lies inside the searched range.
+
+    The vertex of the parabola (in log f) through the best grid point and
+    its neighbours; a minimum at an end of the grid is that end.
+    """
     i = int(np.argmin(costs))
-    inside = 0 < i < len(grid) - 1
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    for _ in range(20):  # golden section on the bracket
-        m1, m2 = a + 0.382 * (b - a), a + 0.618 * (b - a)
-        if _reprojection_cost(m1, uv, W, w) < _reprojection_cost(m2, uv, W, w):
-            b = m2
-        else:
-            a = m1
-    return 0.5 * (a + b), inside
+    if i == 0 or i == len(grid) - 1:
+        return float(grid[i]), False
+    c0, c1, c2 = costs[i - 1 : i + 2]
+    curv = c0 - 2.0 * c1 + c2
+    step = 0.5 * (c0 - c2) / curv if curv > 0 else 0.0
+    h = np.log(grid[1] / grid[0])
+    return float(grid[i] * np.exp(np.clip(step, -1.0, 1.0) * h)), True
 
 
 def _rest_heights(body: Body) -> tuple[float, np.ndarray]:
@@ -254,17 +291,22 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
     if len(leg_ok) >= MIN_FRAMES:
         Wf = Wf * (leg_model / float(np.median(leg_ok)))
 
-    f, resolved = _best_focal(uv, Wf, wts, w_img)
+    # Every frame's cost at every candidate focal length, once: the clip's
+    # cost and each bootstrap resample's are then weighted sums of its rows.
+    m = _moments(uv, Wf, wts)
+    grid = _focal_grid(w_img)
+    costs = _frame_costs(grid, uv, Wf, wts, m)
+    f, resolved = _best_focal(grid, costs.sum(1))
     rng = np.random.default_rng(seed)
     n_blocks = max(1, len(frames) // BLOCK_FRAMES)
     blocks = np.array_split(np.arange(len(frames)), n_blocks)
     boot = []
     for _ in range(BOOTSTRAP if n_blocks > 1 else 0):
         pick = np.concatenate([blocks[i] for i in rng.integers(0, n_blocks, n_blocks)])
-        boot.append(_best_focal(uv[pick], Wf[pick], wts[pick], w_img)[0])
+        boot.append(_best_focal(grid, costs @ np.bincount(pick, minlength=len(frames)))[0])
     f_sd = float(np.std(boot, ddof=1)) if len(boot) > 1 else float("nan")
 
-    P = Wf + _translations(f, uv, Wf, wts)[:, None]
+    P = Wf + _translations(f, m)[:, None]
     feet = P[:, list(_FOOT)]
     feet_seen = seen[frames][:, list(_FOOT)]
     hips = 0.5 * (P[:, 23] + P[:, 24])

@@ -81,7 +81,9 @@ def extract_frames(
     Returns
     -------
     KeypointTrack
-        Frames with no person (or no marker) are NaN with visibility 0.
+        Frames with no person (or no marker) are NaN with visibility 0.  A
+        frame identical to the one before it is not read again: it repeats
+        that frame's keypoints.
 
     Raises
     ------
@@ -98,6 +100,7 @@ def extract_frames(
     est.reset()
     times, xy, vis, pres, world, crops = [], [], [], [], [], []
     size = None
+    last_image, r = None, None
     for i, item in enumerate(frames):
         frame = item if isinstance(item, Frame) else Frame(i, i / float(fps), np.asarray(item))
         h, w = frame.image.shape[:2]
@@ -105,7 +108,13 @@ def extract_frames(
             size = (w, h)
         elif size != (w, h):
             raise KeypointError(f"frame {frame.index} is {w}x{h}, expected {size[0]}x{size[1]} like frame 0")
-        r = est.process(frame.image, frame.time)
+        # A frame identical to the one before (a held frame: a low frame rate
+        # padded to the container's, a frozen screen recording) is the same
+        # observation; reading it again would only cost time and tell the
+        # filters the body stood still.
+        if last_image is None or not np.array_equal(frame.image, last_image):
+            r = est.process(frame.image, frame.time)
+        last_image = frame.image
         times.append(frame.time)
         if r is None:
             xy.append(np.full((NUM_LANDMARKS, 3), np.nan))

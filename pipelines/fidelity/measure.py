@@ -142,7 +142,15 @@ def _jitter(uv: np.ndarray, cond: Condition, rng: np.random.Generator) -> np.nda
     return np.floor(noisy) + 0.5  # a detector reports pixel centres
 
 
-def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random.Generator, score: Score | None = None):
+def capture(
+    mode: str,
+    motion,
+    kept: np.ndarray,
+    cond: Condition,
+    rng: np.random.Generator,
+    score: Score | None = None,
+    threads: int = 2,
+):
     """Capture the kept frames of a performance.
 
     Parameters
@@ -154,6 +162,8 @@ def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random
     rng : numpy.random.Generator
     score : Score, optional
         The take's score (needed by the video path, which renders it).
+    threads : int
+        The pose model's threads on the video path (1 when jobs run side by side).
 
     Returns
     -------
@@ -216,14 +226,14 @@ def capture(mode: str, motion, kept: np.ndarray, cond: Condition, rng: np.random
     if mode == "video":
         if score is None:
             raise PipelineError("the video capture path needs the take's score to render it")
-        j, c = _capture_video(score, motion, kept, cond, rng, calibrated)
+        j, c = _capture_video(score, motion, kept, cond, rng, calibrated, threads)
         out[kept], conf[kept] = j[kept], c[kept]
         out[conf == 0] = np.nan
         return out, conf
     raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
 
 
-def _capture_video(score: Score, motion, kept, cond: Condition, rng, calibrated: bool = False):
+def _capture_video(score: Score, motion, kept, cond: Condition, rng, calibrated: bool = False, threads: int = 2):
     """Render, degrade (hold, JPEG, noise) and capture a take; joints (T,J,3) and confidence (T,J)."""
     import tempfile
     from pathlib import Path
@@ -258,7 +268,10 @@ def _capture_video(score: Score, motion, kept, cond: Condition, rng, calibrated:
                     _ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
                     img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
                 if cond.noise:
-                    img = np.clip(img + rng.normal(0.0, cond.noise, img.shape), 0, 255).astype(np.uint8)
+                    noisy = rng.standard_normal(img.shape, dtype=np.float32)
+                    noisy *= cond.noise
+                    noisy += img
+                    img = np.clip(noisy, 0, 255, out=noisy).astype(np.uint8)
                 w.write(img)
         run_capture(
             tmp / "degraded.mp4",
@@ -268,6 +281,7 @@ def _capture_video(score: Score, motion, kept, cond: Condition, rng, calibrated:
             progress=False,
             seed=int(rng.integers(2**31)),
             calibration=tmp / "render" / CAMERA_FILE if calibrated else None,
+            threads=threads,
         )
         with np.load(tmp / "capture" / "capture.npz") as z:
             joints = np.asarray(z["joints"], float)

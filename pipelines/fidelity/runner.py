@@ -56,7 +56,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: Bumped when the measurement changes, so cached jobs are recomputed.
-STUDY_VERSION = f"{__version__}-fidelity-4"
+STUDY_VERSION = f"{__version__}-fidelity-5"
 
 #: Capture paths without images (compression cannot be applied).
 IMAGE_FREE = ("truth", "keypoints")
@@ -87,7 +87,7 @@ def resolve_capture(capture) -> tuple[str, ...]:
 
 
 def run_condition(
-    job: Job, seed: int, capture_mode="truth", fps: float = 25.0, bootstrap: int = 30, scores=None
+    job: Job, seed: int, capture_mode="truth", fps: float = 25.0, bootstrap: int = 30, scores=None, threads: int = 2
 ) -> dict:
     """Perform, record, capture and measure one job.
 
@@ -106,6 +106,8 @@ def run_condition(
         Resamples for the Effort intervals.
     scores : dict, optional
         Phrase name → Score (default: the built-in phrases).
+    threads : int
+        The pose model's threads on the video path (the result does not depend on it).
 
     Returns
     -------
@@ -124,7 +126,7 @@ def run_condition(
         if callable(capture_mode):
             joints, conf = capture_mode(motion, kept, c, rng)
         else:
-            joints, conf = capture(capture_mode, motion, kept, c, rng, score)
+            joints, conf = capture(capture_mode, motion, kept, c, rng, score, threads)
         row.update(measure(score, motion, joints, conf, kept, rng, bootstrap))
         row["error"] = ""
     except C2NError as exc:
@@ -134,8 +136,10 @@ def run_condition(
 
 
 def _job_worker(args):
-    job, seed, mode, fps, bootstrap, digest = args
-    return run_condition(job, seed, mode, fps, bootstrap) | {"job": digest}
+    # OpenCV's thread count is left alone: resizing its pool in a forked
+    # worker waits for threads that stayed in the parent.
+    job, seed, mode, fps, bootstrap, digest, threads = args
+    return run_condition(job, seed, mode, fps, bootstrap, threads=threads) | {"job": digest}
 
 
 class StudyResult:
@@ -265,7 +269,11 @@ def run_study(
         write_text(_cache_path(outdir, digest), json.dumps(row, sort_keys=True, default=_json_default))
         rows_by_job[(mode, j)] = row
 
-    args = [(j, cfg.seed, mode, cfg.source_fps, cfg.bootstrap, digest) for mode, j, digest in pending]
+    workers = workers or os.cpu_count() or 1
+    # One pose-model thread a job when jobs run side by side (a cluster's or
+    # this machine's processes), two when they run one at a time here.
+    threads = 1 if scheduler or (workers > 1 and len(pending) > 1) else 2
+    args = [(j, cfg.seed, mode, cfg.source_fps, cfg.bootstrap, digest, threads) for mode, j, digest in pending]
     bar = progress_bar(total=len(args), desc="fidelity study", unit="job", enabled=progress)
     try:
         with stop_on_signals():
@@ -274,7 +282,7 @@ def run_study(
                 args,
                 keep,
                 scheduler=scheduler,
-                workers=workers or os.cpu_count() or 1,
+                workers=workers,
                 timeout=connect_timeout,
                 on_progress=bar.update,
             )

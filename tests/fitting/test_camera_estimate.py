@@ -84,3 +84,40 @@ def test_a_lens_outside_the_searched_range_is_reported_unresolved():
     assert "not resolved" in est.line() and "±" not in est.line().split(",")[0]
     inside = estimate_camera(*_landmarks(3, Camera.phone("front", SIZE, 1.7, 1.0, 0.0, 0.0, 60.0)), SIZE)
     assert inside is not None and inside.focal_resolved and "field of view (focal" in inside.line()
+
+
+def test_translations_from_moments_equal_the_stacked_least_squares():
+    """The per-frame normal equations built from moments solve the same system as lstsq on every landmark row."""
+    from capture2notation.fitting.camera_estimate import _moments, _translations
+
+    rng = np.random.default_rng(7)
+    T, K = 5, 33
+    uv = rng.normal(0, 120, (T, K, 2))
+    W = rng.normal(0, 0.4, (T, K, 3))
+    w = (rng.random((T, K)) > 0.3).astype(float)
+    m = _moments(uv, W, w)
+    for f in (420.0, 910.0):
+        got = _translations(f, m)
+        for t in range(T):
+            x, y = uv[t, :, 0], uv[t, :, 1]
+            A = np.zeros((2 * K, 3))
+            A[0::2, 0], A[0::2, 2], A[1::2, 1], A[1::2, 2] = f, -x, f, -y
+            b = np.empty(2 * K)
+            b[0::2], b[1::2] = x * W[t, :, 2] - f * W[t, :, 0], y * W[t, :, 2] - f * W[t, :, 1]
+            sw = np.sqrt(np.repeat(w[t], 2))
+            ref = np.linalg.lstsq(A * sw[:, None], b * sw, rcond=None)[0]
+            np.testing.assert_allclose(got[t], ref, rtol=1e-6, atol=1e-9)
+    batched = _translations(np.array([420.0, 910.0]), m)
+    np.testing.assert_allclose(batched[1], _translations(910.0, m), rtol=1e-12)
+
+
+@pytest.mark.parametrize("true_f", [231.7, 800.0, 1100.0])
+def test_best_focal_refines_between_grid_points(true_f):
+    """A cost quadratic in log f has its minimum recovered exactly from the grid; a minimum at an end is unresolved."""
+    from capture2notation.fitting.camera_estimate import _best_focal, _focal_grid
+
+    grid = _focal_grid(640.0)
+    f, inside = _best_focal(grid, (np.log(grid) - np.log(true_f)) ** 2)
+    assert inside and f == pytest.approx(true_f, rel=1e-9)
+    f, inside = _best_focal(grid, grid)  # decreasing focal: cheapest at the widest lens
+    assert not inside and f == grid[0]

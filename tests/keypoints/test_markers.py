@@ -128,3 +128,20 @@ def test_extract_frames_rejects_bad_input():
     frames = [np.zeros((8, 8, 3), np.uint8), np.zeros((9, 8, 3), np.uint8)]
     with pytest.raises(KeypointError, match=r"frame 1 is 8x9, expected 8x8"):
         extract_frames(frames, 10, backend="markers", markers=[GREEN])
+
+
+def test_held_frames_are_read_once_and_repeat_their_keypoints():
+    """A frame identical to the one before is not read again; a changed one is, even if it repeats an older one."""
+    a = _scene([((40.0, 40.0), (0, 200, 0))])
+    b = _scene([((90.0, 70.0), (0, 200, 0))])
+    tracker = MarkerTracker([GREEN])
+    calls = []
+    process = tracker.process
+    tracker.process = lambda img, t: calls.append(t) or process(img, t)
+    frames = [a, a.copy(), a, b, b, a]
+    track = extract_frames(frames, 10, backend="markers", estimator=tracker)
+    np.testing.assert_allclose(calls, [0.0, 0.3, 0.5])
+    np.testing.assert_allclose(track.xy[:3, 15, :2], [[40.0, 40.0]] * 3, atol=0.5)
+    np.testing.assert_allclose(track.xy[3:5, 15, :2], [[90.0, 70.0]] * 2, atol=0.5)
+    np.testing.assert_allclose(track.xy[5, 15, :2], [40.0, 40.0], atol=0.5)
+    np.testing.assert_allclose(track.times, np.arange(6) / 10)
