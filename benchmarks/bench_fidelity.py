@@ -6,8 +6,8 @@ Prints: resampling and DTW speed, seconds per study job on each capture
 path (and the full default study's estimated wall time on this machine's
 cores); with ``--video N`` the seconds of N seeded random jobs of the full
 default grid on the real video path and the full video study's estimate;
-with ``--workers PATH`` the wall time of a small study (24 jobs) with 1 and
-2 local worker processes and the speed-up; with ``--quick-study`` the wall
+with ``--workers PATH`` the wall time of a small study (24 jobs) with 1, 2
+and 4 local worker processes and the speed-ups; with ``--quick-study`` the wall
 time of ``c2n fidelity-study --quick`` and its observer accuracy.  ``--only``
 skips the first three.  Nothing is asserted.
 """
@@ -113,7 +113,7 @@ def bench_video_sample(n: int = 8, seed: int = 0) -> None:
 
 
 def bench_workers(capture: str = "keypoints", repeats: int = 2) -> None:
-    """Wall time of one small study with 1 and with 2 local worker processes (fresh caches)."""
+    """Wall time of one small study with 1, 2 and 4 local worker processes (fresh caches)."""
     from pipelines.fidelity import StudyConfig, run_study
 
     cfg = StudyConfig(
@@ -139,7 +139,7 @@ def bench_workers(capture: str = "keypoints", repeats: int = 2) -> None:
 
     wall = {}
     for _rep in range(repeats):
-        for w in (1, 2):
+        for w in (1, 2, 4):
             with tempfile.TemporaryDirectory() as d:
                 load = os.getloadavg()[0]
                 t, c = time.perf_counter(), cpu()
@@ -151,8 +151,8 @@ def bench_workers(capture: str = "keypoints", repeats: int = 2) -> None:
                 )
     best = {w: min(v) for w, v in wall.items()}
     print(
-        f"speed-up 1 -> 2 local workers ({capture}): {best[1] / best[2]:.2f}x (MEASURED, best of {repeats}; "
-        f"load {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)"
+        f"speed-up 1 -> 2 local workers ({capture}): {best[1] / best[2]:.2f}x, 1 -> 4: {best[1] / best[4]:.2f}x "
+        f"(MEASURED, best of {repeats}; load {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)"
     )
 
 
@@ -174,7 +174,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick-study", action="store_true", help="also time c2n fidelity-study --quick")
     ap.add_argument("--video", type=int, default=0, metavar="N", help="time N random video jobs of the full study")
-    ap.add_argument("--workers", choices=("keypoints", "video", "truth"), help="time 1 vs 2 workers on a small study")
+    ap.add_argument(
+        "--workers", choices=("keypoints", "video", "truth"), help="time 1, 2 and 4 workers on a small study"
+    )
     ap.add_argument("--only", action="store_true", help="skip the resampling, DTW and per-job figures")
     args = ap.parse_args()
     if not args.only:

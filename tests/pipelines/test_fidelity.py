@@ -186,3 +186,23 @@ def test_a_scheduler_without_dask_says_which_extra(tmp_path, tiny_study, monkeyp
     cfg = StudyConfig(**tiny_study)
     with pytest.raises(PipelineError, match=r"capture2notation\[cluster\]"):
         run_study(cfg, tmp_path, scheduler="tcp://127.0.0.1:9", progress=False, connect_timeout=2)
+
+
+def test_jobs_are_scheduled_longest_first_by_beats_and_pixels():
+    """Longer phrases first; on the video path larger images first; the keypoint path ignores the image size."""
+    from dataclasses import replace
+
+    from pipelines.fidelity.runner import _job_cost
+
+    scores = builtin_scores()
+    by_beats = sorted(scores, key=lambda n: float(scores[n].duration))
+    short, long_ = by_beats[0], by_beats[-1]
+    small = cond("25", "keyframe")
+    large = replace(small, width=1280, height=720)
+
+    def job(phrase, c):
+        return Job(c, Performance(phrase, "medium", "sad", 0, "test"))
+
+    assert _job_cost("video", job(short, large), scores) > _job_cost("video", job(short, small), scores)
+    assert _job_cost("keypoints", job(short, large), scores) == _job_cost("keypoints", job(short, small), scores)
+    assert _job_cost("keypoints", job(long_, small), scores) > _job_cost("keypoints", job(short, small), scores)
