@@ -18,12 +18,13 @@ Capture paths (``capture`` in the study config):
     proportions and the camera the fit estimates from the landmarks (what a
     user without a calibration has).  Compression is not modelled.
 ``video``
-    The whole chain: the renderer draws the take
-    (:func:`synthetic.render.job.render_score`), the kept frames are held
-    in between (Neagle's emulation of a low rate at 25 Hz), JPEG-compressed
-    at the condition's quality and given Gaussian pixel noise, and
-    :func:`pipelines.capture.capture` (BlazePose, fitting, segmentation)
-    reads the video with no calibration.  Several seconds of CPU per job.
+    The whole chain: the mannequin renderer draws the take's kept frames
+    (:func:`synthetic.render.job.make_renderer`), each held until the next
+    (Neagle's emulation of a low rate at 25 Hz), JPEG-compressed at the
+    condition's quality and given Gaussian pixel noise, written once as
+    H.264, and :func:`pipelines.capture.capture` (BlazePose, fitting,
+    segmentation) reads the video with no calibration.  A few seconds of
+    CPU per job.
 ``keypoints-calibrated``, ``video-calibrated``
     The same with the renderer's camera given to the fit (as ``c2n capture
     --calibration camera.toml`` would): the named calibrated condition.
@@ -148,7 +149,6 @@ def capture(
     kept: np.ndarray,
     cond: Condition,
     rng: np.random.Generator,
-    score: Score | None = None,
     threads: int = 2,
 ):
     """Capture the kept frames of a performance.
@@ -160,8 +160,6 @@ def capture(
     kept : (M,) ndarray of int
     cond : Condition
     rng : numpy.random.Generator
-    score : Score, optional
-        The take's score (needed by the video path, which renders it).
     threads : int
         The pose model's threads on the video path (1 when jobs run side by side).
 
@@ -224,63 +222,66 @@ def capture(
         conf[kept] = res.confidence
         return out, conf
     if mode == "video":
-        if score is None:
-            raise PipelineError("the video capture path needs the take's score to render it")
-        j, c = _capture_video(score, motion, kept, cond, rng, calibrated, threads)
+        j, c = _capture_video(motion, kept, cond, rng, calibrated, threads)
         out[kept], conf[kept] = j[kept], c[kept]
         out[conf == 0] = np.nan
         return out, conf
     raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
 
 
-def _capture_video(score: Score, motion, kept, cond: Condition, rng, calibrated: bool = False, threads: int = 2):
-    """Render, degrade (hold, JPEG, noise) and capture a take; joints (T,J,3) and confidence (T,J)."""
+def _capture_video(motion, kept, cond: Condition, rng, calibrated: bool = False, threads: int = 2):
+    """Render, degrade (hold, JPEG, noise) and capture a take; joints (T,J,3) and confidence (T,J).
+
+    The renderer draws each shown frame once, straight into the video the
+    capture reads (one H.264 generation, as a camera writes it); a held
+    frame repeats the image of the frame it holds, compressed alike, with
+    fresh pixel noise.
+    """
     import tempfile
     from pathlib import Path
 
     import cv2
 
     from capture2notation.compare.resample import hold_map
-    from capture2notation.io.video import VideoWriter, iter_frames
+    from capture2notation.io.video import VideoWriter
     from pipelines.capture import capture as run_capture
-    from synthetic.render.job import CAMERA_FILE, render_score
+    from synthetic.render.job import CAMERA_FILE, make_renderer, write_camera_toml
+    from synthetic.render.scene import Pose
 
     T = motion.n_frames
+    if T == 0:
+        raise PipelineError("the performance has no frames to render")
+    cam = _camera(cond, motion.body.height)
+    renderer = make_renderer(Pose.from_motion(motion), cam, "mannequin")
+    shown = hold_map(kept, T)
     with tempfile.TemporaryDirectory(prefix="c2n-fidelity-") as tmp:
         tmp = Path(tmp)
-        render_score(
-            score,
-            tmp / "render",
-            fps=motion.fps,
-            size=(cond.width, cond.height),
-            view=cond.view,
-            progress=False,
-            body=motion.body,
-        )
-        frames = [f.image for f in iter_frames(tmp / "render" / "video.mp4")]
-        if not frames:
-            raise PipelineError("the renderer wrote an empty video")
-        shown = hold_map(kept, T)
-        with VideoWriter(tmp / "degraded.mp4", motion.fps, (cond.width, cond.height)) as w:
+        image, drawn = None, -1
+        with VideoWriter(tmp / "video.mp4", motion.fps, (cond.width, cond.height)) as w:
             for i in range(T):
-                img = frames[min(shown[i], len(frames) - 1)]
-                if cond.compression:
-                    _ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
-                    img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+                if shown[i] != drawn:
+                    drawn = int(shown[i])
+                    image = renderer.frame(drawn)
+                    if cond.compression:
+                        _ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
+                        image = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+                img = image
                 if cond.noise:
-                    noisy = rng.standard_normal(img.shape, dtype=np.float32)
+                    noisy = rng.standard_normal(image.shape, dtype=np.float32)
                     noisy *= cond.noise
-                    noisy += img
+                    noisy += image
                     img = np.clip(noisy, 0, 255, out=noisy).astype(np.uint8)
                 w.write(img)
+        if calibrated:
+            write_camera_toml(cam, tmp / CAMERA_FILE, name="video")
         run_capture(
-            tmp / "degraded.mp4",
+            tmp / "video.mp4",
             tmp / "capture",
             effort=False,
             overlay=False,
             progress=False,
             seed=int(rng.integers(2**31)),
-            calibration=tmp / "render" / CAMERA_FILE if calibrated else None,
+            calibration=tmp / CAMERA_FILE if calibrated else None,
             threads=threads,
         )
         with np.load(tmp / "capture" / "capture.npz") as z:

@@ -126,7 +126,7 @@ def run_condition(
         if callable(capture_mode):
             joints, conf = capture_mode(motion, kept, c, rng)
         else:
-            joints, conf = capture(capture_mode, motion, kept, c, rng, score, threads)
+            joints, conf = capture(capture_mode, motion, kept, c, rng, threads)
         row.update(measure(score, motion, joints, conf, kept, rng, bootstrap))
         row["error"] = ""
     except C2NError as exc:

@@ -206,3 +206,46 @@ def test_jobs_are_scheduled_longest_first_by_beats_and_pixels():
     assert _job_cost("video", job(short, large), scores) > _job_cost("video", job(short, small), scores)
     assert _job_cost("keypoints", job(short, large), scores) == _job_cost("keypoints", job(short, small), scores)
     assert _job_cost("keypoints", job(long_, small), scores) > _job_cost("keypoints", job(short, small), scores)
+
+
+@pytest.mark.parametrize("noise", [0.0, 4.0])
+def test_video_path_holds_kept_frames_and_noises_every_frame(monkeypatch, noise):
+    """The frames written for the capture: one per source frame, a held frame repeats its image unless noised."""
+    from capture2notation.body import JOINTS
+    from pipelines.fidelity import measure as measure_mod
+
+    written, seen = [], {}
+
+    class Writer:
+        def __init__(self, path, fps, size):
+            seen["size"] = size
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def write(self, img):
+            written.append(img.astype(int))
+
+    def fake_capture(video, outdir, **kw):
+        seen["threads"] = kw["threads"]
+        outdir.mkdir()
+        J, T = len(JOINTS), len(written)
+        np.savez(outdir / "capture.npz", joints=np.zeros((T, J, 3)), confidence=np.ones((T, J)))
+
+    monkeypatch.setattr("capture2notation.io.video.VideoWriter", Writer)
+    monkeypatch.setattr("pipelines.capture.capture", fake_capture)
+    score, motion = perform(Performance("figure7", "medium", "happy", 0, "test"), 0, 25.0)
+    c = Condition("frame_rate", "5", "naive", 160, 120, "front", 0, noise)
+    kept = kept_frames(c, score, motion.n_frames, motion.fps)
+    joints, conf = measure_mod.capture("video", motion, kept, c, np.random.default_rng(0), threads=1)
+    assert len(written) == motion.n_frames and seen == {"size": (160, 120), "threads": 1}
+    held = sorted(set(range(1, motion.n_frames)) - set(kept.tolist()))
+    diffs = [np.abs(written[i] - written[i - 1]).mean() for i in held]
+    if noise == 0:
+        assert max(diffs) == 0.0
+    else:  # mean |difference| of two independent N(0, 4²) pixels is 4·2/√π ≈ 4.5 (less where clipped)
+        assert 3.5 < float(np.mean(diffs)) < 5.0
+    assert conf[kept].all() and not conf[held].any() and np.isnan(joints[held]).all()
