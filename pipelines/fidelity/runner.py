@@ -56,7 +56,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: Bumped when the measurement changes, so cached jobs are recomputed.
-STUDY_VERSION = f"{__version__}-fidelity-5"
+STUDY_VERSION = f"{__version__}-fidelity-6"
 
 #: Capture paths without images (compression cannot be applied).
 IMAGE_FREE = ("truth", "keypoints")
