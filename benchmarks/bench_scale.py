@@ -217,7 +217,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--video", type=float, default=None, metavar="SECONDS", help="render and capture a clip this long")
     ap.add_argument("--minutes", type=float, nargs="*", default=[], help="keypoint-track clip lengths, minutes")
-    ap.add_argument("--effort", action="store_true", help="--minutes with Effort (slow: about 0.2 CPU s a movement)")
+    ap.add_argument("--effort", action="store_true", help="--minutes with Effort (about 0.06 CPU s a movement)")
     ap.add_argument("--spans", action="store_true", help="held-out phrases fitted whole and in spans")
     ap.add_argument("--workers", type=int, default=min(os.cpu_count() or 1, 4), help="Effort processes")
     ap.add_argument("--workdir", type=Path, default=None, help="keep renders and tracks here (default: a temp dir)")

@@ -26,15 +26,15 @@ take).  Example ``study.toml``::
 Capture paths (:mod:`pipelines.fidelity.measure`): ``video`` (render →
 BlazePose → fit, the real perception path), ``keypoints`` (simulated
 BlazePose landmarks with Gaussian world-landmark noise → fit: the named fast
-condition, about 1 s a job against 4-45 s), ``truth``, and the calibrated
+condition, about 0.8 s a job against 5 s on the video path), ``truth``, and the calibrated
 conditions ``keypoints-calibrated`` / ``video-calibrated``.  ``capture`` is
 one of them or a list: every listed path runs the whole grid, the first is
 the primary one (the figures and conclusions of the report) and the report
-compares the paths condition by condition.  ``auto`` is :data:`AUTO_CAPTURE`.
-The video path is not the default because the full default grid (816 jobs)
-on it is estimated at well over the 45-min budget on 2 cores (see
-``docs/benchmarks/scale.md``); run ``capture = ["video", "keypoints"]`` to
-measure real against simulated perception.
+compares the paths condition by condition.  ``auto`` is :data:`AUTO_CAPTURE`:
+the video path, with the keypoint path beside it (the full default grid,
+816 video and 720 keypoint jobs, took 39 minutes on 2 cores; see
+``docs/benchmarks/scale.md``); the ``--quick`` study's ``auto`` is the
+keypoint path alone.
 
 Every value is checked for its type and range (:func:`check`): a wrong one
 is a one-line error naming the key and the value.
@@ -52,10 +52,12 @@ from capture2notation.compare.resample import as_rate
 from capture2notation.errors import PipelineError
 from capture2notation.notation.model import EMOTIONS
 
-__all__ = ["AUTO_CAPTURE", "CAPTURES", "StudyConfig", "check", "load_config", "quick"]
+__all__ = ["AUTO_CAPTURE", "CAPTURES", "QUICK_AUTO_CAPTURE", "StudyConfig", "check", "load_config", "quick"]
 
-#: What ``capture = "auto"`` runs: the simulated-keypoint path (see the module docstring for why not video).
-AUTO_CAPTURE = ("keypoints",)
+#: What ``capture = "auto"`` runs: the real video path, compared with the simulated-keypoint path.
+AUTO_CAPTURE = ("video", "keypoints")
+#: What ``capture = "auto"`` runs in the ``--quick`` study: the fast path alone.
+QUICK_AUTO_CAPTURE = ("keypoints",)
 CAPTURES = ("auto", "truth", "keypoints", "video", "keypoints-calibrated", "video-calibrated")
 RESAMPLING = ("keyframe", "naive")
 VIEWS = ("front", "45", "side")
@@ -282,8 +284,11 @@ def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:
 
     Two phrases (first two of `phrases` when none are configured), two takes,
     the extreme levels of each factor; the capture path is the config's
-    (``auto``: the keypoint path with 3D fitting, about a minute on 2 cores).
+    (``auto``: :data:`QUICK_AUTO_CAPTURE`, the keypoint path with 3D fitting,
+    about a minute on 2 cores).
     """
+    modes = (cfg.capture,) if isinstance(cfg.capture, str) else tuple(cfg.capture)
+    modes = tuple(m for mode in modes for m in (QUICK_AUTO_CAPTURE if mode == "auto" else (mode,)))
 
     def ends(seq):
         seq = tuple(seq)
@@ -292,6 +297,7 @@ def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:
     return replace(
         cfg,
         phrases=tuple(cfg.phrases or phrases)[:2],
+        capture=modes[0] if len(modes) == 1 else modes,
         takes=2,
         training_takes=2,
         frame_rates=ends(cfg.frame_rates),

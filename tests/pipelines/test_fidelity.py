@@ -249,3 +249,21 @@ def test_video_path_holds_kept_frames_and_noises_every_frame(monkeypatch, noise)
     else:  # mean |difference| of two independent N(0, 4²) pixels is 4·2/√π ≈ 4.5 (less where clipped)
         assert 3.5 < float(np.mean(diffs)) < 5.0
     assert conf[kept].all() and not conf[held].any() and np.isnan(joints[held]).all()
+
+
+@pytest.mark.slow
+def test_video_path_reads_the_smallest_default_size_with_an_odd_height(pose_model_path):
+    """220×175 (the default grid's smallest size) cannot be H.264 yuv420p; the job still runs."""
+    c = Condition("image_size", "25", "keyframe", 220, 175, "front", 0, 0.0)
+    row = run_condition(Job(c, Performance("figure7", "medium", "happy", 0, "test")), 0, "video", bootstrap=0)
+    assert row["error"] == ""
+    assert np.isfinite(row["angle_error_deg"]) and 0.0 <= row["symbol_accuracy"] <= 1.0
+
+
+def test_auto_capture_is_the_video_path_beside_keypoints_and_quick_keeps_it_fast():
+    from pipelines.fidelity.runner import resolve_capture
+
+    assert resolve_capture("auto") == ("video", "keypoints")
+    assert quick(StudyConfig(), ("a", "b")).capture == "keypoints"
+    assert quick(StudyConfig(capture=("auto", "truth")), ("a", "b")).capture == ("keypoints", "truth")
+    assert quick(StudyConfig(capture="video"), ("a", "b")).capture == "video"
