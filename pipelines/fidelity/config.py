@@ -32,7 +32,7 @@ one of them or a list: every listed path runs the whole grid, the first is
 the primary one (the figures and conclusions of the report) and the report
 compares the paths condition by condition.  ``auto`` is :data:`AUTO_CAPTURE`:
 the video path, with the keypoint path beside it (the full default grid,
-816 video and 720 keypoint jobs, took 39 minutes on 2 cores; see
+816 video and 720 keypoint jobs, took 33 minutes on 2 cores; see
 ``docs/benchmarks/scale.md``); the ``--quick`` study's ``auto`` is the
 keypoint path alone.
 
