@@ -52,7 +52,16 @@ from capture2notation.compare.resample import as_rate
 from capture2notation.errors import PipelineError
 from capture2notation.notation.model import EMOTIONS
 
-__all__ = ["AUTO_CAPTURE", "CAPTURES", "QUICK_AUTO_CAPTURE", "StudyConfig", "check", "load_config", "quick"]
+__all__ = [
+    "AUTO_CAPTURE",
+    "CAPTURES",
+    "QUICK_AUTO_CAPTURE",
+    "StudyConfig",
+    "check",
+    "expand_capture",
+    "load_config",
+    "quick",
+]
 
 #: What ``capture = "auto"`` runs: the real video path, compared with the simulated-keypoint path.
 AUTO_CAPTURE = ("video", "keypoints")
@@ -279,6 +288,12 @@ def load_config(path=None, overrides: dict | None = None) -> StudyConfig:
         raise PipelineError(where + msg[len("study config") :] if msg.startswith("study config") else msg) from None
 
 
+def expand_capture(capture, auto: tuple = AUTO_CAPTURE) -> tuple[str, ...]:
+    """The capture paths a ``capture`` value names, the primary first, ``auto`` replaced by `auto`, each once."""
+    modes = (capture,) if isinstance(capture, str) else tuple(capture)
+    return tuple(dict.fromkeys(m for mode in modes for m in (auto if mode == "auto" else (mode,))))
+
+
 def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:
     """The ``--quick`` study: a tiny grid that still exercises every factor.
 
@@ -287,8 +302,7 @@ def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:
     (``auto``: :data:`QUICK_AUTO_CAPTURE`, the keypoint path with 3D fitting,
     about a minute on 2 cores).
     """
-    modes = (cfg.capture,) if isinstance(cfg.capture, str) else tuple(cfg.capture)
-    modes = tuple(m for mode in modes for m in (QUICK_AUTO_CAPTURE if mode == "auto" else (mode,)))
+    modes = expand_capture(cfg.capture, QUICK_AUTO_CAPTURE)
 
     def ends(seq):
         seq = tuple(seq)

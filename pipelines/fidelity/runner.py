@@ -39,7 +39,7 @@ from capture2notation.compare.discrimination import (
 from capture2notation.errors import C2NError, PipelineError
 
 from .conditions import Condition, Job, build_conditions, build_jobs, phrase_complexity, stable_seed
-from .config import AUTO_CAPTURE, StudyConfig
+from .config import StudyConfig, expand_capture
 from .measure import builtin_scores, capture, kept_frames, measure, perform
 from .pool import StudyInterrupted, _Stop, execute, signal_of, stop_on_signals
 
@@ -82,8 +82,7 @@ ID_COLUMNS = (
 
 def resolve_capture(capture) -> tuple[str, ...]:
     """The capture paths to run, the primary first: ``auto`` is :data:`~.config.AUTO_CAPTURE`."""
-    modes = (capture,) if isinstance(capture, str) else tuple(capture)
-    return tuple(dict.fromkeys(m for mode in modes for m in (AUTO_CAPTURE if mode == "auto" else (mode,))))
+    return expand_capture(capture)
 
 
 def run_condition(
