@@ -319,7 +319,9 @@ def calibrate_cameras(
         U, _, Vt = np.linalg.svd(Rw)  # re-orthonormalise against rounding
         K, dist = _K_dist(res.intrinsics[c])
         out.append(CameraCalibration(name, detections[c].image_size, K, dist, U @ Vt, tw, rms_px=rms[name]))
-    for c, name in enumerate(names):
+    # The worst camera is named: one bad clip spreads some of its error to the
+    # cameras it shares board views with through the bundle adjustment.
+    for c, name in sorted(enumerate(names), key=lambda cn: -np.nan_to_num(rms[cn[1]], nan=np.inf)):
         if not rms[name] <= MAX_RMS_PX:
             raise CalibrationError(
                 f"{detections[c].source}: camera {name}'s reprojection RMS is {rms[name]:.2f} px, above the "
