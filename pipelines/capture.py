@@ -523,7 +523,7 @@ def notate(
     title = Path(input_path).stem if Path(input_path).is_file() else Path(input_path).name
     given = Fraction(SECONDS_TEMPO) if tempo == NO_TEMPO else tempo
     # The same reading with the tempo given or, where none can be found, one beat a second.
-    common = dict(meter=meter, params=params, title=title, axes=axes, feet_seen=seen)
+    common = dict(meter=meter, params=params, title=title, axes=axes, feet_seen=seen, line_of_sight=line_of_sight)
     try:
         seg = segment_motion(joints, fps, tempo=given, tempo_evidence=evidence, **common)
     except QuantiseError as exc:

@@ -60,7 +60,7 @@ from scipy.signal import savgol_filter
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS
 from .labels import DIRECTION_NAMES, FrameLabels
-from .measured import held_pose, hold_frames, keep_previous, upright_trunk
+from .measured import held_pose, hold_frames, keep_previous, trunk_tilt_beyond_noise, upright_trunk
 from .movement import Movement
 from .params import SegmentParams
 from .spans import _ZERO_SPEED, movement_spans
@@ -229,10 +229,14 @@ def _label_at(labels: FrameLabels, col: int, frames: slice) -> tuple[str, str, i
     return DIRECTION_NAMES[d[0]], LEVELS[lv[0]], bend
 
 
-def _tilt_deg(labels: FrameLabels, col: int, frames: slice) -> float:
-    """Angle of a column's median vector over `frames` from vertical, degrees."""
+def _tilt_beyond_noise(labels: FrameLabels, col: int, frames: slice, margin: float, depth) -> float:
+    """Tilt of a column's held vector over `frames` beyond the fit's trunk noise, degrees."""
     v, _ = held_pose(labels.vectors[:, col], None, frames)
-    return float(np.degrees(np.arccos(np.clip(v[2] / np.linalg.norm(v), -1.0, 1.0))))
+    d = None
+    if depth is not None:
+        d = np.nanmean(np.asarray(depth)[frames], axis=0) if np.ndim(depth) == 2 else np.asarray(depth, float)
+        d = d / np.linalg.norm(d)
+    return trunk_tilt_beyond_noise(v, margin, d)
 
 
 def _off_canonical_deg(labels: FrameLabels, col: int, frames: slice) -> float:
@@ -455,7 +459,30 @@ def gesture_movements(
     params: SegmentParams,
     on_grid: np.ndarray | None = None,
     measured: bool = False,
+    depth: np.ndarray | None = None,
 ) -> list[Movement]:
+    """The gesture movements of the arms, legs, head and chest (module docstring).
+
+    Parameters
+    ----------
+    labels : FrameLabels
+    joints : (T, J, 3) ndarray
+        World joints, metres, z up.
+    fps : float
+    params : SegmentParams
+    on_grid : (T,) ndarray of bool, optional
+        Frames on the beat grid (clean motion parts only there).
+    measured : bool
+        Fitted or motion-captured joints (never exactly still).
+    depth : (T, 3) ndarray, optional
+        One camera's horizontal line of sight in body axes
+        (:func:`~.measured.depth_axes`): a measured chest's lean is then
+        corrected and judged in depth only (:func:`~.measured.upright_trunk`).
+
+    Returns
+    -------
+    list of Movement
+    """
     out: list[Movement] = []
     T = labels.direction.shape[0]
     # Noisy poses are averaged over up to this long a hold after the arrival.
@@ -465,7 +492,7 @@ def gesture_movements(
         labels, margin = all_labels, 0.0
         if measured and part == "chest":
             # A fitted chest leans by a bias of its own (see .measured).
-            labels, margin = upright_trunk(all_labels, part)
+            labels, margin = upright_trunk(all_labels, part, depth)
         whole = labels.index(part)
         u_list, reach, bend_list = channel(labels, joints, part)
         noise = max([noise_deg(u) for u in u_list] + [_scalar_noise(x) for x in bend_list])
@@ -557,7 +584,7 @@ def gesture_movements(
                 continue
             if part not in LIMBS:
                 bend = 0
-                if margin and _tilt_deg(labels, whole, frames) < _TILT_DEG + margin:
+                if margin and _tilt_beyond_noise(labels, whole, frames, margin, depth) < _TILT_DEG:
                     # Within the fit's own trunk noise of upright.
                     d, lv = _DEFAULT[part]
             if not clean:

@@ -19,9 +19,11 @@ __all__ = [
     "HYSTERESIS_DEG",
     "TRUNK_MAX_BIAS_DEG",
     "TRUNK_MAX_MARGIN_DEG",
+    "depth_axes",
     "held_pose",
     "hold_frames",
     "keep_previous",
+    "trunk_tilt_beyond_noise",
     "upright_trunk",
 ]
 
@@ -31,6 +33,9 @@ TRUNK_MAX_BIAS_DEG = 35.0
 #: Cap of the noise margin a measured trunk tilt must exceed, degrees.
 TRUNK_MAX_MARGIN_DEG = 10.0
 _UP = np.array([0.0, 0.0, 1.0])
+#: Horizontal share of a line of sight below which a camera looks (nearly)
+#: straight down or up: sin 10°, an overhead camera, whose depth is vertical.
+_MIN_HORIZONTAL = 0.17
 
 
 def _rotation_to_up(v: np.ndarray) -> np.ndarray:
@@ -44,26 +49,38 @@ def _rotation_to_up(v: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
-def upright_trunk(labels: FrameLabels, part: str) -> tuple[FrameLabels, float]:
+def upright_trunk(labels: FrameLabels, part: str, depth: np.ndarray | None = None) -> tuple[FrameLabels, float]:
     """`labels` with `part`'s vectors measured from the clip's own upright, and its noise margin.
 
     The part (``chest``) is upright most of a phrase (DESIGN.md: it starts
     upright, and a written tilt is held for a few beats at most), so the
-    median of its direction over the clip is where the fit puts the upright
-    pose; it is rotated onto vertical.  A median farther than
-    :data:`TRUNK_MAX_BIAS_DEG` from vertical is a tilt held by the dancer and
-    is left alone.  The margin is the 90th percentile of the corrected tilt
-    from vertical, capped at :data:`TRUNK_MAX_MARGIN_DEG`: a tilt symbol must
-    exceed its threshold by it to be more than the fit's own trunk noise,
-    which is not white — a fitted chest straightens by 20-25° whenever the
-    arms rise — so a percentile, not a deviation, measures it.  Capped, a
-    written tilt (45°) still clears threshold plus margin.
+    median of its direction over the frames nearer vertical is where the fit
+    puts the upright pose.  A median farther than :data:`TRUNK_MAX_BIAS_DEG`
+    from vertical is a tilt held by the dancer and is left alone.  The
+    margin is the 90th percentile of the corrected tilt from vertical,
+    capped at :data:`TRUNK_MAX_MARGIN_DEG`: a tilt symbol must exceed its
+    threshold by it to be more than the fit's own trunk noise, which is not
+    white — a fitted chest straightens by 20-25° whenever the arms rise —
+    so a percentile, not a deviation, measures it.  Capped, a written tilt
+    (45°) still clears threshold plus margin.
+
+    With one camera's line of sight (`depth`) the bias is taken to lie along
+    it only: across the image the chest is measured, in depth the fit leans
+    it (measured on renders: the upright chest's fitted lean across the
+    image is 0-3°, along the line of sight 3-21°).  Only the lean in depth
+    is then removed, frame by frame about the axis across the image, so a
+    phrase of mostly tilted chests (whose nearer-vertical frames are tilts
+    too) is not rotated sideways by its own tilts.
 
     Parameters
     ----------
     labels : FrameLabels
     part : str
         A single-vector part (``chest``, ``head``).
+    depth : (T, 3) or (3,) ndarray, optional
+        The camera's line of sight in the labels' body axes
+        (:func:`depth_axes`); None when not one camera (motion files,
+        several cameras).
 
     Returns
     -------
@@ -81,16 +98,87 @@ def upright_trunk(labels: FrameLabels, part: str) -> tuple[FrameLabels, float]:
     # The upright pose: the median over the frames nearer vertical, so that
     # a written tilt held for a third of the phrase does not pull it over.
     raw = np.degrees(np.arccos(np.clip(v[ok, 2], -1.0, 1.0)))
-    m = np.median(v[ok][raw <= np.percentile(raw, 60)], axis=0)
+    near = raw <= np.percentile(raw, 60)
+    m = np.median(v[ok][near], axis=0)
     m /= np.linalg.norm(m)
     if np.degrees(np.arccos(np.clip(m @ _UP, -1.0, 1.0))) > TRUNK_MAX_BIAS_DEG:
         return labels, 0.0
-    R = _rotation_to_up(m)
     vectors = labels.vectors.copy()
-    vectors[:, col] = v @ R.T
+    if depth is None:
+        vectors[:, col] = v @ _rotation_to_up(m).T
+    else:
+        d = np.broadcast_to(np.asarray(depth, dtype=float), v.shape)
+        lean = np.arctan2(np.sum(v * d, axis=-1), v[:, 2])  # (T,) radians towards the camera's axis
+        sel = lean[ok][near]
+        bias = float(np.median(sel[np.isfinite(sel)])) if np.isfinite(sel).any() else 0.0
+        vectors[:, col] = _lean_back(v, d, bias)
     tilt = np.degrees(np.arccos(np.clip(vectors[ok, col, 2], -1.0, 1.0)))
     margin = min(TRUNK_MAX_MARGIN_DEG, float(np.percentile(tilt, 90)))
     return replace(labels, vectors=vectors), margin
+
+
+def depth_axes(frame: np.ndarray, line_of_sight) -> np.ndarray:
+    """A camera's horizontal line of sight in body axes at each frame.
+
+    Parameters
+    ----------
+    frame : (T, 3, 3) ndarray
+        Body frames (rows right, forward, up; :func:`~capture2notation.body.body_frame`).
+    line_of_sight : (3,) array_like
+        The camera's viewing axis in the world (z up).
+
+    Returns
+    -------
+    (T, 3) ndarray or None
+        Unit horizontal vectors (z = 0) in body axes, NaN where the frame
+        is; None for a camera looking straight down or up (within
+        :data:`_MIN_HORIZONTAL` of vertical), which sees no lean in depth.
+    """
+    los = np.asarray(line_of_sight, dtype=float).copy()
+    los[2] = 0.0  # body up is world up: the lean in depth is about a horizontal axis
+    n = np.linalg.norm(los)
+    if not np.isfinite(n) or n < _MIN_HORIZONTAL * np.linalg.norm(line_of_sight):
+        return None
+    return frame @ (los / n)
+
+
+def _lean_back(v: np.ndarray, d: np.ndarray, angle: float) -> np.ndarray:
+    """Rotate unit vectors `v` (T, 3) by −`angle` (radians) in the plane of vertical and `d` (T, 3, horizontal)."""
+    a = np.sum(v * d, axis=-1, keepdims=True)  # component along d
+    z = v[:, 2:3]
+    rest = v - a * d - z * _UP  # the component across the line of sight is kept
+    c, s = np.cos(angle), np.sin(angle)
+    return rest + (c * a - s * z) * d + (s * a + c * z) * _UP
+
+
+def trunk_tilt_beyond_noise(v: np.ndarray, margin: float, depth: np.ndarray | None = None) -> float:
+    """A held trunk vector's tilt from vertical less the fit's noise margin, degrees.
+
+    Without a line of sight the whole tilt is reduced by `margin`.  With one
+    (`depth`, horizontal, in the same body axes) only the tilt in depth is:
+    the fit's trunk noise is a lean towards or away from the camera, and a
+    lean across the image is measured (see :func:`upright_trunk`).
+
+    Parameters
+    ----------
+    v : (3,) ndarray
+        Held direction (need not be unit), body axes.
+    margin : float
+        Degrees (:func:`upright_trunk`).
+    depth : (3,) ndarray, optional
+
+    Returns
+    -------
+    float
+        Degrees; a tilt symbol needs at least the tilt threshold.
+    """
+    v = np.asarray(v, dtype=float) / np.linalg.norm(v)
+    if depth is None or not np.isfinite(depth).all():
+        return float(np.degrees(np.arccos(np.clip(v[2], -1.0, 1.0)))) - margin
+    along = float(v @ depth)
+    across = float(np.linalg.norm(v - along * depth - v[2] * _UP))
+    in_depth = max(abs(np.degrees(np.arctan2(along, v[2]))) - margin, 0.0)
+    return float(np.hypot(np.degrees(np.arctan2(across, v[2])), in_depth))
 
 
 #: Hysteresis of measured labels, degrees: a fitted limb direction is off by

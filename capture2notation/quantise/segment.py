@@ -27,6 +27,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..body import body_frame
 from ..errors import QuantiseError
 from ..notation.model import Score, Symbol
 from .contact import decode_contacts
@@ -42,6 +43,7 @@ from .gestures import (
     noise_deg,
 )
 from .labels import FrameLabels, flat_foot_pitch, label_frames, support_frames, with_supports
+from .measured import depth_axes
 from .movement import Movement
 from .params import SegmentParams
 from .spans import movement_spans
@@ -124,6 +126,7 @@ def segment_motion(
     tempo_evidence=None,
     axes: str = "standard",
     feet_seen=None,
+    line_of_sight=None,
 ) -> Segmentation:
     """Segment a motion into notation symbols.
 
@@ -150,6 +153,10 @@ def segment_motion(
     feet_seen : (T, 2) array_like of bool, optional
         Right, left foot measured by the capture at each frame (default:
         wherever finite).  A foot not seen is never taken to bear weight.
+    line_of_sight : (3,) array_like, optional
+        A single camera's viewing axis in the joints' world, for fitted
+        video: the fit's trunk errs along it (:func:`~.measured.upright_trunk`).
+        None for motion files and several cameras.
 
     Returns
     -------
@@ -166,6 +173,8 @@ def segment_motion(
     # Turns are read from the motion as it is; supports and steps from the
     # motion with its turns undone about their pivots (:mod:`.travel`).
     turning, turned = joints, turned_so_far(joints, fps, measured)
+    # The camera's line of sight in body axes, from the body as it faces the camera.
+    depth = None if line_of_sight is None or not measured else depth_axes(body_frame(joints), line_of_sight)
     if np.any(turned != 0.0):
         joints = unturn(joints, turned, labels.supporting)
         labels = label_frames(joints, fps, floor, axes=axes)
@@ -190,7 +199,7 @@ def segment_motion(
     moves, detail = None, None
     if estimated:
         moves = (
-            gesture_movements(labels, joints, fps, params, measured=measured)
+            gesture_movements(labels, joints, fps, params, measured=measured, depth=depth)
             + with_flights(
                 support_movements(labels, joints, fps, params, movement_spans, measured=measured) if floor_seen else [],
                 labels,
@@ -253,7 +262,7 @@ def segment_motion(
         take_offs = np.zeros(T, bool)
         take_offs[[t0 for t0, _ in flights]] = True
         moves = (
-            gesture_movements(labels, joints, fps, params, on_grid, measured)
+            gesture_movements(labels, joints, fps, params, on_grid, measured, depth)
             + with_flights(
                 support_movements(
                     labels,

@@ -94,7 +94,12 @@ MOVES = [
 ]
 
 
-def test_a_fitted_chest_leaning_by_its_own_bias_writes_no_chest_symbol():
+#: The camera of these fits: in front of the dancer (on +y, looking along −y).
+FRONT_CAMERA = (0.0, -1.0, 0.0)
+
+
+@pytest.mark.parametrize("line_of_sight", [None, FRONT_CAMERA])
+def test_a_fitted_chest_leaning_by_its_own_bias_writes_no_chest_symbol(line_of_sight):
     """A fitted chest leans 20-30° towards the camera all through a phrase
     (over the 22.5° of ``chest forward high``), wobbling by several degrees
     with the arms: chest symbols the dancer never made."""
@@ -102,18 +107,42 @@ def test_a_fitted_chest_leaning_by_its_own_bias_writes_no_chest_symbol():
     T = len(angles)
     for seed in (0, 1, 2):
         lean = 24.0 + 6.0 * np.sin(np.linspace(0.0, 3.0 * np.pi, T))
-        score = segment_motion(_with_chest(angles, lean, seed), FPS, tempo=72).score
+        score = segment_motion(_with_chest(angles, lean, seed), FPS, tempo=72, line_of_sight=line_of_sight).score
         assert [s for s in normalise(score).symbols if s.part == "chest"] == []
 
 
-def test_a_written_chest_tilt_survives_the_fit_bias():
+@pytest.mark.parametrize("line_of_sight", [None, FRONT_CAMERA])
+def test_a_written_chest_tilt_survives_the_fit_bias(line_of_sight):
     """The same bias with a 45° forward tilt held for two beats: still one tilt and its return."""
     _, angles = build_motion(MOVES, 72, beats=8)
     T = len(angles)
     tilt = 24.0 + 45.0 * (_ease(T, 72.0, 2, 1) - _ease(T, 72.0, 5, 1))
-    score = segment_motion(_with_chest(angles, tilt, 3), FPS, tempo=72).score
+    score = segment_motion(_with_chest(angles, tilt, 3), FPS, tempo=72, line_of_sight=line_of_sight).score
     chest = [(s.direction, s.level) for s in normalise(score).symbols if s.part == "chest"]
     assert chest == [("forward", "high"), ("place", "high")]
+
+
+def test_a_side_tilt_the_fit_reads_short_is_written_with_the_line_of_sight():
+    """The fit reads a 45° side tilt of the chest as ~30° (measured on
+    renders: 27-49°) and leans the chest 15° towards the camera throughout.
+    Without the camera's line of sight the noise margin (10°) is taken off
+    every tilt, and 30° − 10° falls under the 22.5° of ``right high``: no
+    chest symbol at all.  With it only the lean in depth is discounted, and
+    the right tilt, the left tilt and the return to upright are written."""
+    _, angles = build_motion(MOVES, 72, beats=12)
+    T = len(angles)
+    side = 30.0 * (_ease(T, 72.0, 0, 1) - 2.0 * _ease(T, 72.0, 4, 1) + _ease(T, 72.0, 9, 1))
+    for seed in (4, 5, 6):
+        a = angles.copy()
+        a[:, joint_index("waist"), 1] += np.radians(side)
+        joints = _with_chest(a, np.full(T, 15.0), seed)
+        unaware = segment_motion(joints, FPS, tempo=72).score
+        assert [s for s in normalise(unaware).symbols if s.part == "chest"] == []
+        score = segment_motion(joints, FPS, tempo=72, line_of_sight=FRONT_CAMERA).score
+        chest = [(s.direction, s.level) for s in normalise(score).symbols if s.part == "chest"]
+        written = iter(chest)  # in this order; a wobble's detour (out and back) between them allowed
+        assert all(c in written for c in [("right", "high"), ("left", "high"), ("place", "high")]), chest
+        assert len(chest) <= 5, chest
 
 
 def test_movements_chained_without_a_hold_part_at_the_written_pose_between_them():
@@ -436,3 +465,32 @@ def test_a_gesturing_foot_brushing_the_floor_takes_no_weight(seed):
     noisy = j + _correlated(j.shape, 0.003, seed)
     sup = _supports(segment_motion(noisy, FPS, tempo=score.tempo).score)
     assert "right_support" not in [p for _, _, p, _, _ in sup], sup
+
+
+def test_tilt_beyond_noise_discounts_depth_only_with_a_line_of_sight():
+    """Analytic cases: a 30° tilt across the image keeps its 30°; along the
+    line of sight it loses the margin; without a line of sight every tilt does."""
+    from capture2notation.quantise.measured import trunk_tilt_beyond_noise
+
+    depth = np.array([0.0, 1.0, 0.0])
+    t = np.radians(30.0)
+    across, along = np.array([np.sin(t), 0.0, np.cos(t)]), np.array([0.0, np.sin(t), np.cos(t)])
+    assert trunk_tilt_beyond_noise(across, 10.0, depth) == pytest.approx(30.0)
+    assert trunk_tilt_beyond_noise(along, 10.0, depth) == pytest.approx(20.0)
+    assert trunk_tilt_beyond_noise(along * [1, -1, 1], 10.0, depth) == pytest.approx(20.0)  # away from the camera
+    assert trunk_tilt_beyond_noise(across, 10.0) == pytest.approx(20.0)
+    # a 40° tilt half-way between: √(lateral² + (depth − margin)²) of its two lean angles
+    u = np.array([np.sin(np.radians(40.0)) / np.sqrt(2)] * 2 + [np.cos(np.radians(40.0))])
+    lat = np.degrees(np.arctan2(u[0], u[2]))
+    assert trunk_tilt_beyond_noise(u, 5.0, depth) == pytest.approx(np.hypot(lat, lat - 5.0))
+
+
+def test_depth_axes_follow_the_body_and_an_overhead_camera_has_none():
+    from capture2notation.quantise.measured import depth_axes
+
+    # body frames (rows right, forward, up): facing the camera, then turned a quarter left
+    facing = np.eye(3)
+    turned = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    d = depth_axes(np.stack([facing, turned]), (0.0, -2.0, -0.5))  # pitched down, from the front
+    np.testing.assert_allclose(d, [[0.0, -1.0, 0.0], [-1.0, 0.0, 0.0]], atol=1e-12)
+    assert depth_axes(np.stack([facing]), (0.05, 0.0, -1.0)) is None
