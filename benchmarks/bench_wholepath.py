@@ -1,6 +1,6 @@
 """The whole path on phrases kept out of development: accuracy and speed.
 
-Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phrases DIR] [--explain]``.
+Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phrases DIR | --random N [--first-seed S]] [--explain]``.
 
 Each phrase (``benchmarks/holdout/*.lab`` by default: eight phrases of arms,
 legs and supports written for this measurement and never used to tune the
@@ -17,7 +17,10 @@ Printed (never asserted): per phrase and overall, the symbol agreement
 (direction + level per part per beat of the original) and overall the
 cells lost out of those compared, the median start-time error in beats, whether the truth capture is exact, the median limb-direction
 error and MPJPE of the fit, and frames per second of the whole video capture.
-With ``--explain``, under each phrase, the beats it loses: per part, the
+``--random N`` measures N random scores of 16 beats
+(:func:`synthetic.random_score`, seeds from ``--first-seed``) instead of
+phrases: pick seeds never used in development.  The summary gives the
+agreement of each column (part) over all phrases too.  With ``--explain``, under each phrase, the beats it loses: per part, the
 reference's state and the capture's
 (:func:`capture2notation.compare.agreement.agreement_cells`).
 
@@ -35,6 +38,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -160,6 +164,7 @@ def measure(
         "frames": truth.n_frames,
         "missed": [c for c in cells if c.ref != c.cand],
         "cells": len(cells),
+        "columns": Counter(c.part for c in cells),
     }
 
 
@@ -183,6 +188,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--view", default="front", choices=("front", "45", "side"))
     ap.add_argument("--phrases", type=Path, default=HOLDOUT, help="folder of .lab phrases")
+    ap.add_argument("--random", type=int, default=0, metavar="N", help="measure N random scores instead of phrases")
+    ap.add_argument("--first-seed", type=int, default=80_000, help="seed of the first random score")
     ap.add_argument("--effort", action="store_true", help="include the Effort estimate in the timed capture")
     ap.add_argument("--tempo-given", action="store_true", help="give the video capture the written tempo")
     ap.add_argument("--explain", action="store_true", help="list the beats each phrase loses")
@@ -206,9 +213,9 @@ def main() -> None:
         "by default it sees only the video, as a user's capture does",
     )
     args = ap.parse_args()
-    paths = sorted(args.phrases.glob("*.lab"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
+        paths = sorted(args.phrases.glob("*.lab")) if not args.random else _random_phrases(args, Path(tmp) / "scores")
         for p in paths:
             r = measure(
                 p,
@@ -248,6 +255,24 @@ def main() -> None:
     print(f"  median limb-direction error           {np.median([r['limb_deg'] for r in rows]):.1f}°")
     print(f"  MPJPE (mean over phrases)             {np.mean([r['mpjpe_cm'] for r in rows]):.1f} cm")
     print(f"  whole capture speed (frame-weighted)  {np.average([r['fps'] for r in rows], weights=weights):.1f} fps")
+    total = sum((r["columns"] for r in rows), Counter())
+    lost = Counter(c.part for r in rows for c in r["missed"])
+    print(
+        "  agreement by column                   " + ", ".join(f"{p} {1 - lost[p] / n:.0%}" for p, n in total.items())
+    )
+
+
+def _random_phrases(args, folder: Path) -> list[Path]:
+    """``--random`` scores written as .lab files in `folder`."""
+    from capture2notation.notation.formats import write
+    from synthetic import random_score
+
+    folder.mkdir(parents=True)
+    paths = []
+    for seed in range(args.first_seed, args.first_seed + args.random):
+        paths.append(folder / f"seed{seed}.lab")
+        write(random_score(np.random.default_rng(seed), 16), paths[-1])
+    return paths
 
 
 if __name__ == "__main__":
