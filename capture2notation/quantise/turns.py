@@ -58,6 +58,12 @@ _HIGH_SPEED_DEG_S = 20.0
 #: neighbouring peaks split two turns (at 0.35, 1 cm of jitter on the hips
 #: split one half turn over two beats into 3/8 + 1/8).
 _SPLIT_RATIO = 0.2
+#: Measured motion: a turn changes the front for good, so the front over
+#: this long after it (seconds) must differ from the front over this long
+#: before it: fitted hips swing out and back 35-50° within half a second
+#: (and a mirrored pair of hips turns half way and back), the dancer's
+#: front not changing.  Half a second is a beat at 120 bpm.
+_HELD_S = 0.5
 #: Measured motion: smoothing window of the front, seconds (a beat and a
 #: half at 150 bpm: 1 cm of jitter on the hips is ~6° of front per frame).
 _SMOOTH_S = 0.6
@@ -151,11 +157,20 @@ def turn_movements(
         key.needs_minimum = lambda f: True  # type: ignore[attr-defined]
         spans = movement_spans(speed, _CLEAN_SPEED_DEG_S, _CLEAN_SPEED_DEG_S, 0.0, key_pose=key)
     feet = _feet_heading(joints)
+    held = max(1, int(round(_HELD_S * fps)))
     out = []
+    # Where the front was last held: a swing not taken for a turn does not
+    # move it (the swing back must be measured from before the swing out).
+    anchor, swing_end = 0, -(10**9)
     for a, b in spans:
+        if a - swing_end > held:
+            anchor = a
         delta = float(front[b + 1] - front[a])
         eighths = int(round(delta / EIGHTH_DEG))
         if eighths == 0 or (measured and abs(delta) < MIN_MEASURED_EIGHTHS * EIGHTH_DEG):
+            continue
+        if measured and not _front_held(front, anchor, b + 1, delta, held):
+            swing_end = b + 1
             continue
         if not _feet_turn_too(feet, a, b + 1, delta):
             continue
@@ -172,6 +187,18 @@ def turn_movements(
             )
         )
     return out
+
+
+def _front_held(front: np.ndarray, a: int, b: int, delta: float, window: int) -> bool:
+    """Whether a measured turn from frame a to b leaves the front changed (see :data:`_HELD_S`).
+
+    The median front over `window` frames after the turn must differ from
+    the median over `window` frames before it by :data:`MIN_MEASURED_EIGHTHS`,
+    the turn's way.
+    """
+    before = np.nanmedian(front[max(0, a - window + 1) : a + 1])
+    after = np.nanmedian(front[b : b + window])
+    return bool(np.sign(delta) * (after - before) >= MIN_MEASURED_EIGHTHS * EIGHTH_DEG)
 
 
 def _feet_heading(joints: np.ndarray) -> np.ndarray:

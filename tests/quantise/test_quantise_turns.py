@@ -193,3 +193,19 @@ def test_turn_and_jump_phrase_captures_exactly_with_estimated_tempo():
     seg = segment_motion(interpret(score, fps=FPS).joints(), FPS)
     assert seg.tempo == score.tempo
     assert score_differences(score, seg.score) == []
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_measured_swing_out_and_back_is_no_turn_but_a_held_one_is(seed):
+    """Fitted hips swing 45° out and back within half a second (measured on
+    renders of a dancer who never turns), the feet with them: the front has
+    not changed, so no turn is written.  The same eighth turn held for two
+    beats before turning back is two turns."""
+    rng = np.random.default_rng(seed)
+    swing = interpret(_turn_score([(0, 0.5, "right", "1/8"), (0.5, 0.5, "left", "1/8")], tempo=120), fps=FPS)
+    joints = swing.joints()
+    assert turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True) == []
+    held = interpret(_turn_score([(0, 1, "right", "1/8"), (3, 1, "left", "1/8")], tempo=60), fps=FPS)
+    joints = held.joints()
+    got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
+    assert [(m.direction, m.amount) for m in got] == [("right", Fraction(1, 8)), ("left", Fraction(1, 8))]
