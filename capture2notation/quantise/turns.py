@@ -10,7 +10,9 @@ A turn is a window of rotation speed, cut like a gesture
 (:func:`~.spans.movement_spans`): clean motion (the virtual dancer's truth,
 exactly held outside turns) turns on every frame of a turn and not at all
 elsewhere; back-to-back turns part only at a grid frame where the front
-sits on an eighth.  Measured motion is smoothed and cut at speed minima.
+sits on an eighth.  Measured motion is smoothed and cut at speed minima,
+and a measured turn must leave the front changed for half a second
+(:data:`_HELD_S`): fitted hips swing out and back without the dancer turning.
 The amount is the change of front rounded to eighths, ``right`` for
 clockwise (increasing front); a change under half an eighth is no turn.
 """
@@ -64,6 +66,10 @@ _SPLIT_RATIO = 0.2
 #: (and a mirrored pair of hips turns half way and back), the dancer's
 #: front not changing.  Half a second is a beat at 120 bpm.
 _HELD_S = 0.5
+#: Measured motion: a turn taken straight back is a swing of the fitted hips
+#: only when it is smaller than this many eighths (67.5°): the fit's swings
+#: measure 35-50°, while a quarter turn and straight back is danced.
+SWING_MAX_EIGHTHS = 1.5
 #: Measured motion: smoothing window of the front, seconds (a beat and a
 #: half at 150 bpm: 1 cm of jitter on the hips is ~6° of front per frame).
 _SMOOTH_S = 0.6
@@ -162,14 +168,16 @@ def turn_movements(
     # Where the front was last held: a swing not taken for a turn does not
     # move it (the swing back must be measured from before the swing out).
     anchor, swing_end = 0, -(10**9)
-    for a, b in spans:
+    for i, (a, b) in enumerate(spans):
         if a - swing_end > held:
             anchor = a
         delta = float(front[b + 1] - front[a])
         eighths = int(round(delta / EIGHTH_DEG))
         if eighths == 0 or (measured and abs(delta) < MIN_MEASURED_EIGHTHS * EIGHTH_DEG):
             continue
-        if measured and not _front_held(front, anchor, b + 1, delta, held):
+        if measured and not _front_held(
+            front, anchor, b + 1, delta, held, spans[i + 1] if i + 1 < len(spans) else None
+        ):
             swing_end = b + 1
             continue
         if not _feet_turn_too(feet, a, b + 1, delta):
@@ -189,15 +197,25 @@ def turn_movements(
     return out
 
 
-def _front_held(front: np.ndarray, a: int, b: int, delta: float, window: int) -> bool:
+def _front_held(front: np.ndarray, a: int, b: int, delta: float, window: int, following=None) -> bool:
     """Whether a measured turn from frame a to b leaves the front changed (see :data:`_HELD_S`).
 
     The median front over `window` frames after the turn must differ from
     the median over `window` frames before it by :data:`MIN_MEASURED_EIGHTHS`,
-    the turn's way.
+    the turn's way.  Another turn starting within the window (`following`,
+    its span) ends it there, unless that turn only takes this one back (the
+    front after both within the same margin of the front before) and this
+    one is under :data:`SWING_MAX_EIGHTHS`: then the two are one swing out
+    and back.
     """
-    before = np.nanmedian(front[max(0, a - window + 1) : a + 1])
-    after = np.nanmedian(front[b : b + window])
+    before = float(np.nanmedian(front[max(0, a - window + 1) : a + 1]))
+    end = b + window
+    if following is not None and following[0] < end:
+        back = front[min(following[1] + 1, front.size - 1)] - before
+        if abs(back) < MIN_MEASURED_EIGHTHS * EIGHTH_DEG and abs(delta) < SWING_MAX_EIGHTHS * EIGHTH_DEG:
+            return False
+        end = max(following[0], b + 1)
+    after = float(np.nanmedian(front[b:end]))
     return bool(np.sign(delta) * (after - before) >= MIN_MEASURED_EIGHTHS * EIGHTH_DEG)
 
 

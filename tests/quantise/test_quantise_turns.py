@@ -209,3 +209,12 @@ def test_a_measured_swing_out_and_back_is_no_turn_but_a_held_one_is(seed):
     joints = held.joints()
     got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
     assert [(m.direction, m.amount) for m in got] == [("right", Fraction(1, 8)), ("left", Fraction(1, 8))]
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_quarter_turn_and_straight_back_is_two_turns(seed):
+    """Larger than any swing of fitted hips (SWING_MAX_EIGHTHS): danced, written."""
+    rng = np.random.default_rng(seed)
+    joints = interpret(_turn_score([(0, 1, "right", "1/4"), (1, 1, "left", "1/4")], tempo=120), fps=FPS).joints()
+    got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
+    assert [(m.direction, m.amount) for m in got] == [("right", Fraction(1, 4)), ("left", Fraction(1, 4))]
