@@ -24,12 +24,13 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
+from itertools import pairwise
 
 import numpy as np
 
 from ..body import body_frame
 from ..errors import QuantiseError
-from ..notation.model import Score, Symbol
+from ..notation.model import AIR, Score, Symbol
 from .contact import decode_contacts
 from .flight import find_flights, with_flights
 from .gestures import (
@@ -315,30 +316,69 @@ def segment(
 
 
 def _merge_times(moves: list[Movement], params: SegmentParams, tempo: float) -> list[Movement]:
-    """Pull key times of different parts that lie within the merge window onto their median."""
+    """Pull key times of different parts that lie within the merge window onto their median.
+
+    Times closer than the window are grouped (single linkage), and a group
+    spanning more than the window is split at its widest gap until none
+    does: chained neighbours could otherwise gather the key times of half a
+    second of several parts, a movement's start and arrival among them, and
+    collapse it to nothing.  A movement whose start and arrival would still
+    meet keeps its own times.
+    """
     if not moves:
         return moves
     window = min(params.merge_window_s, 0.45 * float(params.grid) * 60.0 / tempo)
     t = np.array([x for m in moves for x in (m.start_time, m.end_time)])
-    order = np.argsort(t)
+    order = np.argsort(t, kind="stable")
     ts = t[order]
-    cluster = np.r_[0, np.cumsum(np.diff(ts) > window)]
     out_t = np.empty_like(t)
-    for c in np.unique(cluster):
-        sel = cluster == c
-        out_t[order[sel]] = np.median(ts[sel])
-    return [replace(m, start_time=float(out_t[2 * i]), end_time=float(out_t[2 * i + 1])) for i, m in enumerate(moves)]
+    for lo, hi in _groups(ts, window):
+        out_t[order[lo:hi]] = np.median(ts[lo:hi])
+    out = []
+    for i, m in enumerate(moves):
+        t0, t1 = float(out_t[2 * i]), float(out_t[2 * i + 1])
+        collapsed = t1 <= t0 and m.start_time < m.end_time
+        out.append(m if collapsed else replace(m, start_time=t0, end_time=t1))
+    return out
+
+
+def _groups(ts: np.ndarray, window: float) -> list[tuple[int, int]]:
+    """Index ranges [lo, hi) of sorted times `ts` grouped as :func:`_merge_times` says."""
+    cuts = [0, *(np.flatnonzero(np.diff(ts) > window) + 1).tolist(), ts.size]
+    todo = list(pairwise(cuts))
+    out = []
+    while todo:
+        lo, hi = todo.pop()
+        if ts[hi - 1] - ts[lo] <= window:
+            out.append((lo, hi))
+            continue
+        k = lo + 1 + int(np.argmax(np.diff(ts[lo:hi])))  # split at the widest gap
+        todo += [(lo, k), (k, hi)]
+    return out
 
 
 def _symbols(moves: list[Movement], tempo: Fraction, grid: Fraction) -> list[Symbol]:
+    """Movements snapped to the beat grid as symbols, none starting before what it must follow.
+
+    A part's symbol starts no earlier than its previous one ends, and flight
+    and a one-foot support (which cannot overlap: no foot bears weight in
+    flight) no earlier than the other ends.
+    """
     last_end: dict[str, Fraction] = {}
     out: list[Symbol] = []
     for m in sorted(moves, key=lambda m: (m.start_time, m.part)):
         start = snap(m.start_time, tempo, grid)
         end = snap(m.end_time, tempo, grid)
-        start = max(start, last_end.get(m.part, Fraction(0)))
+        air = m.direction == AIR and m.part == "support"
+        after = [m.part] + (list(_ONE_FOOT) if air else [AIR] if m.part in _ONE_FOOT else [])
+        start = max([start] + [last_end[k] for k in after if k in last_end])
         if end <= start:
             end = start + grid
         out.append(Symbol(start, end - start, m.part, m.direction, m.level or None, m.bend, m.amount))
         last_end[m.part] = end
+        if air:
+            last_end[AIR] = end
     return out
+
+
+_ONE_FOOT = ("right_support", "left_support")

@@ -270,3 +270,47 @@ def test_flat_foot_pitch_is_the_lower_decile_of_contacts():
     assert (support_frames(raised, 25.0, flat_pitch=flat)[1] == high).all()
     assert (support_frames(biased, 25.0, flat_pitch=flat)[1] == middle).all()
     assert (support_frames(biased, 25.0)[1] == high).all()
+
+
+def test_key_times_chained_over_half_a_second_do_not_collapse_a_flight():
+    """Found on a fresh render (seed 98210): six parts arriving 0.08 s apart
+    chained every key time from the take-off to the landing into one group
+    of the merge window, so the flight got a zero span and its landing
+    support overlapped it (the capture raised NotationError)."""
+    from capture2notation.notation.model import Score
+    from capture2notation.quantise.movement import Movement
+    from capture2notation.quantise.params import SegmentParams
+    from capture2notation.quantise.segment import _merge_times, _symbols
+
+    fps, tempo = 25.0, F(62)
+    moves = [
+        Movement("support", 24, 36, 0.96, 1.44, "air", ""),
+        Movement("right_support", 36, 86, 1.44, 3.44, "place", "middle"),
+    ]
+    parts = ["right_arm", "left_arm", "head", "chest", "right_leg", "left_leg"]
+    for k, part in enumerate(parts):
+        t = 1.0 + 0.08 * k
+        moves.append(Movement(part, int(t * fps) - 10, int(t * fps), t - 0.4, t, "forward", "middle"))
+    merged = _merge_times(moves, SegmentParams(), float(tempo))
+    window = 0.45 * float(SegmentParams().grid) * 60.0 / float(tempo)
+    for m in merged:
+        assert m.end_time > m.start_time
+    flight = next(m for m in merged if m.direction == "air")
+    assert flight.end_time - flight.start_time > window
+    Score(symbols=tuple(_symbols(merged, tempo, SegmentParams().grid)), tempo=tempo)  # valid: no overlap
+
+
+def test_flight_and_one_foot_support_snapped_onto_each_other_do_not_overlap():
+    from capture2notation.notation.model import Score
+    from capture2notation.quantise.movement import Movement
+    from capture2notation.quantise.segment import _symbols
+
+    # the support's start and the flight's end snap to different beats
+    moves = [
+        Movement("support", 0, 10, 1.00, 1.12, "air", ""),
+        Movement("left_support", 8, 40, 1.05, 2.0, "place", "middle"),
+    ]
+    syms = _symbols(moves, F(60), F(1, 4))
+    air, sup = syms
+    assert sup.start >= air.end
+    Score(symbols=tuple(syms), tempo=F(60))
