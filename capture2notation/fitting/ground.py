@@ -47,6 +47,7 @@ __all__ = [
     "fit_floor",
     "ground_height",
     "level_points",
+    "running_quantile",
 ]
 
 #: Foot joints whose lowest point (less its rest height) is the floor evidence.
@@ -190,7 +191,7 @@ def _fit_tilt(low: np.ndarray) -> np.ndarray:
     return slope
 
 
-def _running_quantile(x: np.ndarray, width: int, q: float) -> np.ndarray:
+def running_quantile(x: np.ndarray, width: int, q: float) -> np.ndarray:
     """Running `q` quantile of `x` over `width` frames (NaN ignored, edges shrink)."""
     T = len(x)
     h = width // 2
@@ -246,7 +247,7 @@ def fit_floor(points: np.ndarray, ok: np.ndarray, fps: float | None, tilt: bool 
         resid[:, 2] -= base
         slope = _fit_tilt(resid) if tilt else np.zeros(2)
         z[good] = low[good, 2] - low[good, :2] @ slope
-        run = _running_quantile(z, width, GROUND_QUANTILE) if good.sum() > width else None
+        run = running_quantile(z, width, GROUND_QUANTILE) if good.sum() > width else None
         if run is None or float(np.nanmax(run) - np.nanmin(run)) <= DRIFT_MIN_M:
             break
         base = run[good]

@@ -23,9 +23,12 @@ module rewrites its movements around each flight found.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..body import body_frame, joint_index
+from ..fitting.ground import DRIFT_WINDOW_S, GROUND_QUANTILE, running_quantile
 from ..notation.directions import classify_indices
 from ..notation.model import AIR, LEVELS
 from .labels import DIRECTION_NAMES, SUPPORT_HEIGHT_M, FrameLabels, foot_points
@@ -76,8 +79,9 @@ def find_flights(
         Frames; only flights with a foot on the floor before and after.
     """
     low, _ = foot_points(np.asarray(joints, float))
+    ground = _local_floor(low, fps, floor) if measured else floor
     # Both feet clear of the floor (a missing foot counts as unknown: no flight).
-    air = np.all(np.stack([lo - floor >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
+    air = np.all(np.stack([lo - ground >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
     if seen is not None:
         air &= np.asarray(seen, bool).all(axis=1)
     edges = np.flatnonzero(np.diff(np.r_[0, air.astype(int), 0]))
@@ -91,6 +95,33 @@ def find_flights(
             continue
         out.append((t0, t1))
     return out
+
+
+def _local_floor(low, fps: float, floor: float) -> np.ndarray:
+    """(T,) the floor measured feet stand on about each frame, never below `floor`.
+
+    A low quantile (:data:`~capture2notation.fitting.ground.GROUND_QUANTILE`)
+    of the lowest foot point over
+    :data:`~capture2notation.fitting.ground.DRIFT_WINDOW_S`, longer than any
+    jump.  Why: a single view's fitted feet float 2-11 cm above the clip's
+    floor for seconds at a time (the camera's pitch, estimated from the
+    person, couples their height to their depth), so against the clip's one
+    floor both feet stayed "clear" from well before a take-off to well after
+    the landing, and the flight's pelvis no longer looked ballistic.
+    """
+    lowest = np.fmin(np.asarray(low[0], float), np.asarray(low[1], float))  # NaN only where neither foot is
+    if not np.isfinite(lowest).any():
+        return np.full(lowest.shape, float(floor))
+    width = max(3, int(round(DRIFT_WINDOW_S * fps)))
+    t = np.arange(lowest.size)
+    ok = np.isfinite(lowest)
+    filled = np.interp(t, t[ok], lowest[ok])  # an unseen stretch takes its neighbours' floor
+    run = (
+        running_quantile(filled, width, GROUND_QUANTILE)
+        if filled.size > width
+        else np.full(filled.size, np.quantile(filled, GROUND_QUANTILE))
+    )
+    return np.maximum(float(floor), run)
 
 
 def _ballistic(joints: np.ndarray, t0: int, t1: int, fps: float) -> bool:
@@ -218,11 +249,21 @@ def with_flights(
                     kept.append(
                         Movement(_SUPPORT_PARTS[p], m.start_frame, t0, m.start_time, t0 / fps, step, LEVELS[lv])
                     )
+                else:
+                    # No foot on the floor by the labels (a fitted floor below
+                    # the one the feet stand on there): a landing between two
+                    # flights keeps its own reading, ended at the take-off.
+                    kept.append(replace(m, end_frame=t0, end_time=min(m.end_time, t0 / fps)))
             elif m.end_frame > rest:
                 kept.append(
                     Movement(m.part, rest, m.end_frame, rest / fps, m.end_time, m.direction, m.level, m.bend, m.amount)
                 )
         feet = tuple(k for k in (0, 1) if low[k][t1] < SUPPORT_HEIGHT_M)
+        at = np.array([low[0][t1], low[1][t1]], float)
+        if not feet and np.isfinite(at).any():
+            # Touchdown is where a foot reached the floor it stands on there
+            # (:func:`_local_floor`); a fitted floor can lie below it.
+            feet = (int(np.nanargmin(at)),)
         if not feet:
             out = kept
             continue

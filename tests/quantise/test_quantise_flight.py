@@ -74,3 +74,35 @@ def test_a_fitted_flight_is_ballistic_by_its_rise_though_its_ends_are_smoothed()
     # level or gliding: no flight.
     assert not _ballistic(_pelvis_track(np.full(n, 0.95)), 0, n - 1, fps)
     assert not _ballistic(_pelvis_track(np.linspace(0.9, 0.96, n)), 0, n - 1, fps)
+
+
+def test_a_fitted_flight_is_found_with_the_feet_floating_above_a_low_floor():
+    """A single view's fitted feet float several centimetres above the clip's
+    floor for seconds (measured on renders: 2-11 cm).  Against that one floor
+    both feet never touch it, so no take-off or landing could be seen; each
+    flight is judged against the floor the feet stand on about then, and its
+    landing is written though no foot comes within 3 cm of the low floor."""
+    from capture2notation.quantise.support_state import smooth_positions
+
+    score = random_scores.random_score(np.random.default_rng(105), n_beats=8, springs=True)
+    clean = interpret(score, fps=FPS).joints()
+    frame = lambda b: int(np.floor(float(b) * 60 / float(score.tempo) * FPS + 0.5))  # noqa: E731
+    want = [(frame(s.start), frame(s.end)) for s, _ in springs(score)]
+    rng = np.random.default_rng(5)
+    floating = clean + rng.normal(0.0, 0.005, clean.shape)
+    # the body floats 8 cm up for 1.2 s either side of each flight (a depth
+    # error of the fit), standing on the floor elsewhere
+    t = np.arange(len(clean))
+    near = np.zeros(len(clean))
+    for a, b in want:
+        near = np.maximum(near, np.clip(1.0 - np.maximum(a - t, t - b) / (1.2 * FPS), 0.0, 1.0) * 2.0)
+    floating[..., 2] += 0.08 * np.minimum(near, 1.0)[:, None]
+    got = find_flights(smooth_positions(floating, FPS), FPS, measured=True)
+    assert len(got) == len(want)
+    for (a, b), (a0, b0) in zip(got, want, strict=True):
+        assert abs(a - a0) <= 3 and abs(b - b0) <= 3
+    seg = segment_motion(floating, FPS, tempo=score.tempo)
+    airs = [s for s in seg.score.symbols if s.is_air]
+    assert len(airs) == len(want)
+    for air in airs:  # each flight is followed by its landing support
+        assert any(s.is_support and not s.is_air and s.start == air.end for s in seg.score.symbols)
