@@ -233,10 +233,13 @@ def _tilt_beyond_noise(labels: FrameLabels, col: int, frames: slice, margin: flo
     """Tilt of a column's held vector over `frames` beyond the fit's trunk noise, degrees."""
     v, _ = held_pose(labels.vectors[:, col], None, frames)
     d = None
-    if depth is not None:
-        d = np.nanmean(np.asarray(depth)[frames], axis=0) if np.ndim(depth) == 2 else np.asarray(depth, float)
-        d = d / np.linalg.norm(d)
-    return trunk_tilt_beyond_noise(v, margin, d)
+    if depth is not None and np.ndim(depth) == 2:
+        rows = np.asarray(depth)[frames]
+        rows = rows[np.isfinite(rows).all(axis=1)]  # no body frame, no line of sight: judged as without one
+        d = rows.mean(axis=0) if len(rows) else None
+    elif depth is not None:
+        d = np.asarray(depth, float)
+    return trunk_tilt_beyond_noise(v, margin, None if d is None else d / np.linalg.norm(d))
 
 
 def _off_canonical_deg(labels: FrameLabels, col: int, frames: slice) -> float:
