@@ -204,17 +204,18 @@ def channel(labels: FrameLabels, joints: np.ndarray, part: str) -> tuple[list, l
     return vec, [np.degrees(reach)], [labels.bend_deg[:, labels.index(part)]]
 
 
-def _lands_at_end(down: np.ndarray, end_f: int, hold: int) -> bool:
-    """Whether a measured foot whose movement arrives at frame `end_f` lands as the clip ends.
+def _lands_after(down: np.ndarray, end_f: int, hold: int) -> bool:
+    """Whether a measured foot whose movement arrives at frame `end_f` lands within `hold` frames of it.
 
-    A closing that arrives on the last frame has no hold after it: the
-    smoothed foot is still above DESIGN.md's 0.2 m/s until then and is in
-    contact on the last frame alone (nothing follows it,
-    :func:`~.labels.support_frames`).  A foot in contact there, its
-    movement's fitted arrival within a hold (`hold` frames) of the end, has
-    landed.
+    A noisy movement's arrival is the fitted logistic's, which runs a few
+    frames ahead of or behind the foot's contact (DESIGN.md's 3 cm and
+    0.2 m/s, read from smoothed feet, which slow down late): a leg closing
+    to the floor was written as a ``place low`` gesture just before its
+    foot landed.  A foot in contact at any frame of the hold after the
+    arrival (the hold the pose is read over) has landed, including a closing
+    that arrives on the clip's last frame with no hold after it.
     """
-    return bool(down[-1]) and end_f >= len(down) - 1 - hold
+    return bool(np.asarray(down[end_f : end_f + hold + 1], bool).any())
 
 
 def _label_at(labels: FrameLabels, col: int, frames: slice) -> tuple[str, str, int]:
@@ -571,7 +572,7 @@ def gesture_movements(
                 continue
             if part in _FOOT and (
                 labels.supporting[end_f, _FOOT[part]]
-                or (not clean and _lands_at_end(labels.supporting[:, _FOOT[part]], end_f, hold))
+                or (not clean and _lands_after(labels.supporting[:, _FOOT[part]], end_f, hold))
             ):
                 # A leg that arrives on the floor is a support, not a gesture.
                 state = ("place", "low", 0)

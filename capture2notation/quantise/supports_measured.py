@@ -12,7 +12,9 @@ so there, in this order:
 1. a foot flickering out of contact while the pelvis is not over the other
    foot keeps supporting (:func:`_balanced_contacts`);
 2. pliés are read from the pelvis height (:func:`_pelvis_plie`);
-3. grounded runs shorter than :data:`MIN_SUPPORT_S` are dropped;
+3. grounded runs shorter than :data:`MIN_SUPPORT_S` are dropped, except
+   the moment a free foot closes beside the standing one
+   (:func:`_closings`);
 4. a one-foot support that frees no foot (both stay on the floor while the
    fitted pelvis drifts over one of them) is a support on both
    (:func:`_feet_that_stay_down`), and a foot brushing the floor between two
@@ -22,7 +24,8 @@ so there, in this order:
 6. a step must move the foot with the weight following
    (:func:`~.support_state.plausible_step`);
 7. the flight of a step belongs to the step (:func:`_join_flights`), and a
-   support not held is dropped (:func:`_drop_unheld`).
+   support not held is dropped or, when the next one leads on, merged into
+   it (:func:`_drop_unheld`).
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from .labels import SUPPORT_SPEED_MS, FrameLabels, foot_points
 from .movement import Movement
 from .support_state import (
     OVER_FOOT_FRACTION,
+    STEP_MIN_FRACTION,
     SUPPORT_PARTS,
     body_height,
     fraction_along,
@@ -157,6 +161,7 @@ def measured_support_movements(labels: FrameLabels, joints: np.ndarray, fps: flo
 
     runs = [r for r in _runs(code) if held(*r)]
     lifted = _lifted(labels.supporting, smooth, fps)
+    runs = _closings(runs, labels.supporting, lifted, smooth, min_len, level)
     runs = _feet_that_stay_down(runs, lifted, min_len)
     runs = _no_touch_downs(runs, lifted, min_len)
     runs, passed = _without_passages(runs, smooth[:, joint_index("pelvis"), 2], fps)
@@ -225,6 +230,83 @@ def measured_support_movements(labels: FrameLabels, joints: np.ndarray, fps: flo
         out.append(Movement(SUPPORT_PARTS[new_part], start, end, max(t0, 0.0), t1, direction, LEVELS[new_level], 0))
         prev_start, prev_end = a, b
     return _drop_unheld(_join_flights(out, smooth))
+
+
+def _closings(runs: list, contact: np.ndarray, lifted: np.ndarray, joints: np.ndarray, min_len: int, level) -> list:
+    """Grounded runs with a run on both feet where a free foot closes beside the standing one.
+
+    A leg gesture that ends on the floor beside the standing foot is a
+    closing: the weight arrives on both feet when that foot lands
+    (DESIGN.md: a movement arrives at its end).  When the next support
+    movement starts at once (the other foot leaves for a step), both feet
+    stand for a frame or two only, below :data:`MIN_SUPPORT_S`, and the
+    closing was lost: the gesture read as a leg returning to ``place low``
+    and the support as the standing foot's.  A foot that was off the floor
+    for at least `min_len` frames, lifted (:func:`_lifted`) on the way, and
+    lands within half a step (:data:`~.support_state.STEP_MIN_FRACTION`) of
+    its place beside the other foot (the hips' spacing) while the other
+    stands for fewer than `min_len` frames, starts a run on both feet
+    lasting while both stand, unless a run on both feet is already within
+    `min_len` frames of it.  A foot landing farther away steps, and both
+    feet standing longer leave the weight to the runs themselves.
+
+    Parameters
+    ----------
+    runs : list of (code, first, last)
+        Grounded runs held long enough (:func:`_runs` of :func:`_state_code`).
+    contact : (T, 2) ndarray of bool
+        Right, left foot on the floor, frame by frame (before any filtering).
+    lifted : (T, 2) ndarray of bool
+        :func:`_lifted`.
+    joints : (T, J, 3) ndarray
+        Smoothed joints.
+    min_len : int
+        Frames of a held run.
+    level : (T,) ndarray of int
+        Support level index per frame (middle where none).
+
+    Returns
+    -------
+    list of (code, first, last)
+    """
+    contact = np.asarray(contact, bool)
+    T = contact.shape[0]
+    height = body_height(joints)
+    out = list(runs)
+    for f in range(min_len, T):
+        for k in (0, 1):
+            if not (contact[f, k] and contact[f, 1 - k] and not contact[f - min_len : f, k].any()):
+                continue
+            e = f - 1  # first frame of the foot's time off the floor
+            while e > 0 and not contact[e - 1, k]:
+                e -= 1
+            if not lifted[e:f, k].any():
+                continue
+            side, other = ("right", "left")[k], ("left", "right")[k]
+            spacing = joints[f, joint_index(f"{side}_hip")] - joints[f, joint_index(f"{other}_hip")]
+            beside = joints[f, joint_index(f"{other}_ankle")] + spacing
+            if not np.linalg.norm((joints[f, joint_index(f"{side}_ankle")] - beside)[:2]) < STEP_MIN_FRACTION * height:
+                continue
+            g = f
+            while g + 1 < T and contact[g + 1].all():
+                g += 1
+            if g - f + 1 >= min_len or any(_state_of(c)[0] == 0 and a - min_len <= f <= b + min_len for c, a, b in out):
+                # Both feet stood long enough for the runs to tell where the
+                # weight went (a step the other foot stayed down for), or the
+                # closing is there already.
+                continue
+            lv = int(level[f]) if level[f] >= 0 else LEVELS.index("middle")
+            cut = []
+            for c, a, b in out:
+                if b < f or a > g:
+                    cut.append((c, a, b))
+                    continue
+                if a < f:
+                    cut.append((c, a, f - 1))
+                if b > g:
+                    cut.append((c, g + 1, b))
+            out = sorted([*cut, (_state_code(0, lv), f, g)], key=lambda r: r[1])
+    return out
 
 
 #: Least vertical speed of the pelvis (m/s) through a middle-level run on
@@ -349,14 +431,17 @@ def _no_touch_downs(runs: list, lifted: np.ndarray, min_len: int) -> list:
 
 
 def _drop_unheld(moves: list) -> list:
-    """Noisy support movements without an excursion that was left before it was reached.
+    """Noisy support movements without a state that was left before it was reached.
 
-    A weight shift (a ``place`` support) that the next support movement
-    starts before it arrives (their fitted logistics overlap), that next one
-    returning to the state before it, never held its state: the fit swayed
-    there and back — typically in the first frames of a clip, while the
-    smoothed feet settle on the floor.  Both are dropped.  A shift followed
-    by a different state (a step, a closing after a step) is kept.
+    A ``place`` support movement (a weight shift, a change of level) that
+    the next support movement starts before it arrives (their fitted
+    logistics overlap) never held its state.  If that next one returns to
+    the state before it, the fit swayed there and back — typically in the
+    first frames of a clip, while the smoothed feet settle on the floor —
+    and both are dropped.  Otherwise the two are one movement to the later
+    state (a relevé lowering as its free foot closes: one ``support place
+    middle``, not a change of level overlapping the closing), from the
+    earlier start.  Steps are neither dropped nor merged.
     """
     out: list = []
     for m in moves:
@@ -366,6 +451,8 @@ def _drop_unheld(moves: list) -> list:
             if (m.part, m.level) == before:
                 out.pop()
                 continue
+            out[-1] = replace(m, start_frame=prev.start_frame, start_time=prev.start_time)
+            continue
         out.append(m)
     return out
 
