@@ -270,42 +270,48 @@ def _closings(runs: list, contact: np.ndarray, lifted: np.ndarray, joints: np.nd
     list of (code, first, last)
     """
     contact = np.asarray(contact, bool)
+    out = list(runs)
+    if contact.shape[0] <= min_len:
+        return out
     T = contact.shape[0]
     height = body_height(joints)
-    out = list(runs)
-    for f in range(min_len, T):
-        for k in (0, 1):
-            if not (contact[f, k] and contact[f, 1 - k] and not contact[f - min_len : f, k].any()):
+    # Landings: a foot down at f, off the floor for the min_len frames before,
+    # the other foot down at f.
+    down_before = np.cumsum(np.r_[np.zeros((1, 2), int), contact.astype(int)], axis=0)
+    landing = np.zeros_like(contact)
+    landing[min_len:] = (down_before[min_len:-1] - down_before[: T - min_len] == 0) & contact[min_len:]
+    landing &= contact[:, ::-1]
+    for f, k in zip(*np.nonzero(landing)):
+        f, k = int(f), int(k)
+        e = f - 1  # first frame of the foot's time off the floor
+        while e > 0 and not contact[e - 1, k]:
+            e -= 1
+        if not lifted[e:f, k].any():
+            continue
+        side, other = ("right", "left")[k], ("left", "right")[k]
+        spacing = joints[f, joint_index(f"{side}_hip")] - joints[f, joint_index(f"{other}_hip")]
+        beside = joints[f, joint_index(f"{other}_ankle")] + spacing
+        if not np.linalg.norm((joints[f, joint_index(f"{side}_ankle")] - beside)[:2]) < STEP_MIN_FRACTION * height:
+            continue
+        g = f
+        while g + 1 < T and contact[g + 1].all():
+            g += 1
+        if g - f + 1 >= min_len or any(_state_of(c)[0] == 0 and a - min_len <= f <= b + min_len for c, a, b in out):
+            # Both feet stood long enough for the runs to tell where the
+            # weight went (a step the other foot stayed down for), or the
+            # closing is there already.
+            continue
+        lv = int(level[f]) if level[f] >= 0 else LEVELS.index("middle")
+        cut = []
+        for c, a, b in out:
+            if b < f or a > g:
+                cut.append((c, a, b))
                 continue
-            e = f - 1  # first frame of the foot's time off the floor
-            while e > 0 and not contact[e - 1, k]:
-                e -= 1
-            if not lifted[e:f, k].any():
-                continue
-            side, other = ("right", "left")[k], ("left", "right")[k]
-            spacing = joints[f, joint_index(f"{side}_hip")] - joints[f, joint_index(f"{other}_hip")]
-            beside = joints[f, joint_index(f"{other}_ankle")] + spacing
-            if not np.linalg.norm((joints[f, joint_index(f"{side}_ankle")] - beside)[:2]) < STEP_MIN_FRACTION * height:
-                continue
-            g = f
-            while g + 1 < T and contact[g + 1].all():
-                g += 1
-            if g - f + 1 >= min_len or any(_state_of(c)[0] == 0 and a - min_len <= f <= b + min_len for c, a, b in out):
-                # Both feet stood long enough for the runs to tell where the
-                # weight went (a step the other foot stayed down for), or the
-                # closing is there already.
-                continue
-            lv = int(level[f]) if level[f] >= 0 else LEVELS.index("middle")
-            cut = []
-            for c, a, b in out:
-                if b < f or a > g:
-                    cut.append((c, a, b))
-                    continue
-                if a < f:
-                    cut.append((c, a, f - 1))
-                if b > g:
-                    cut.append((c, g + 1, b))
-            out = sorted([*cut, (_state_code(0, lv), f, g)], key=lambda r: r[1])
+            if a < f:
+                cut.append((c, a, f - 1))
+            if b > g:
+                cut.append((c, g + 1, b))
+        out = sorted([*cut, (_state_code(0, lv), f, g)], key=lambda r: r[1])
     return out
 
 
