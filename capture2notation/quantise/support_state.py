@@ -31,6 +31,7 @@ __all__ = [
     "STEP_PELVIS_FOLLOWS",
     "SUPPORT_PARTS",
     "body_height",
+    "closing_place",
     "fraction_along",
     "mode_filter",
     "plausible_step",
@@ -256,6 +257,18 @@ def plausible_step(joints: np.ndarray, f: int, a: int, k: int, height: float) ->
     return float(pelvis @ travel) / dist >= STEP_PELVIS_FOLLOWS * dist
 
 
+def closing_place(joints: np.ndarray, frame: int, foot: int) -> np.ndarray:
+    """(3,) where foot `foot` (0 right, 1 left) closes at `frame`: beside the other foot at the hips' spacing.
+
+    A free foot comes down relative to the foot bearing the weight, wherever
+    the pelvis stands over it: landing there is ``place`` (a closing), half a
+    step (:data:`STEP_MIN_FRACTION`) or more away from it a step.
+    """
+    side, other = ("right", "left")[foot], ("left", "right")[foot]
+    spacing = joints[frame, joint_index(f"{side}_hip")] - joints[frame, joint_index(f"{other}_hip")]
+    return joints[frame, joint_index(f"{other}_ankle")] + spacing
+
+
 def step_direction(
     joints,
     labels: FrameLabels,
@@ -289,13 +302,9 @@ def step_direction(
             continue
         if starts is not None and not plausible_step(joints, f, af, k, height):
             continue
-        other = ("left", "right")[f]
         if not labels.supporting[af, f] and labels.supporting[af, 1 - f]:
-            # A free foot comes down relative to the foot bearing the weight:
-            # beside it at the hips' spacing is 'place' (a closing foot),
-            # wherever the pelvis stood over the supporting foot.
-            spacing = joints[af, joint_index(f"{side}_hip")] - joints[af, joint_index(f"{other}_hip")]
-            rel = foot - (joints[af, joint_index(f"{other}_ankle")] + spacing)
+            # A free foot comes down relative to the foot bearing the weight.
+            rel = foot - closing_place(joints, af, f)
         else:
             rel = foot - joints[af, joint_index(f"{side}_hip")]
             if offset is not None:

@@ -44,6 +44,7 @@ from .support_state import (
     STEP_MIN_FRACTION,
     SUPPORT_PARTS,
     body_height,
+    closing_place,
     fraction_along,
     mode_filter,
     smooth_positions,
@@ -244,10 +245,10 @@ def _closings(runs: list, contact: np.ndarray, lifted: np.ndarray, joints: np.nd
     and the support as the standing foot's.  A foot that was off the floor
     for at least `min_len` frames, lifted (:func:`_lifted`) on the way, and
     lands within half a step (:data:`~.support_state.STEP_MIN_FRACTION`) of
-    its place beside the other foot (the hips' spacing) while the other
-    stands for fewer than `min_len` frames, starts a run on both feet
-    lasting while both stand, unless a run on both feet is already within
-    `min_len` frames of it.  A foot landing farther away steps, and both
+    its place beside the other foot (:func:`~.support_state.closing_place`)
+    while the other stands for fewer than `min_len` frames, starts a run on
+    both feet lasting while both stand, unless a run on both feet is already
+    within `min_len` frames of it.  A foot landing farther away steps, and both
     feet standing longer leave the weight to the runs themselves.
 
     Parameters
@@ -288,10 +289,8 @@ def _closings(runs: list, contact: np.ndarray, lifted: np.ndarray, joints: np.nd
             e -= 1
         if not lifted[e:f, k].any():
             continue
-        side, other = ("right", "left")[k], ("left", "right")[k]
-        spacing = joints[f, joint_index(f"{side}_hip")] - joints[f, joint_index(f"{other}_hip")]
-        beside = joints[f, joint_index(f"{other}_ankle")] + spacing
-        if not np.linalg.norm((joints[f, joint_index(f"{side}_ankle")] - beside)[:2]) < STEP_MIN_FRACTION * height:
+        ankle = joints[f, joint_index(("right_ankle", "left_ankle")[k])]
+        if not np.linalg.norm((ankle - closing_place(joints, f, k))[:2]) < STEP_MIN_FRACTION * height:
             continue
         g = f
         while g + 1 < T and contact[g + 1].all():
