@@ -435,11 +435,10 @@ def leg_tracks(sup: Support, symbols, frame, T: int, eff: Effort):
         floor, landing = sup.floor[foot], sup.landing[foot]
         Qg, bg = Q.copy(), beta.copy()
         ankle_g = ankle.copy()
-        held = sup.released[foot]
-        for run in np.split(np.flatnonzero(held), np.flatnonzero(np.diff(held) < 0) + 1) if held.any() else []:
-            if run.size:
-                # A released leg holds the pose it had when the support ended.
-                Qg[run], bg[run], ankle_g[run] = Q[run[0] - 1], beta[run[0] - 1], ankle[run[0] - 1]
+        held = np.flatnonzero(sup.released[foot])
+        for run in np.split(held, np.flatnonzero(np.diff(held) > 1) + 1) if held.size else []:
+            # A released leg holds the pose it had when the support ended.
+            Qg[run], bg[run], ankle_g[run] = Q[run[0] - 1], beta[run[0] - 1], ankle[run[0] - 1]
         for f0, f1, syms in group_moves(limb, symbols, frame, T):
             stop = f1 + 1 + int(np.argmax(floor[f1 + 1 :])) if np.any(floor[f1 + 1 :]) else T
             a0 = ankle_g[f0].copy()

@@ -35,7 +35,7 @@ from .labels import DIRECTION_NAMES, SUPPORT_HEIGHT_M, FrameLabels, foot_points
 from .movement import Movement
 from .support_state import STEP_MIN_FRACTION, step_direction, support_state
 
-__all__ = ["find_flights", "with_flights"]
+__all__ = ["find_flights", "landing_rest", "with_flights"]
 
 #: Shortest flight of clean motion, frames: one frame clear of the floor.
 _MIN_CLEAN_FRAMES = 1
@@ -145,8 +145,8 @@ def _ballistic(joints: np.ndarray, t0: int, t1: int, fps: float) -> bool:
     return bool(acc <= -BALLISTIC_FRACTION * GRAVITY_MS2)
 
 
-def _rest_frame(joints: np.ndarray, t1: int, fps: float, on_grid: np.ndarray | None) -> int:
-    """First frame after touchdown `t1` where the pelvis comes to rest (a speed minimum)."""
+def landing_rest(joints: np.ndarray, t1: int, fps: float, on_grid: np.ndarray | None) -> int:
+    """First frame after touchdown `t1` where the pelvis comes to rest (a speed minimum): the landing's end."""
     p = joints[:, joint_index("pelvis")]
     s = np.linalg.norm(np.diff(p, axis=0), axis=-1) * fps  # interval i: frames i → i+1
     T = p.shape[0]
@@ -236,7 +236,7 @@ def with_flights(
     low, _ = foot_points(joints)
     out = list(moves)
     for t0, t1 in flights:
-        rest = _rest_frame(joints, t1, fps, on_grid)
+        rest = landing_rest(joints, t1, fps, on_grid)
         kept = []
         for m in out:
             if m.end_frame <= t0 or m.start_frame >= rest:

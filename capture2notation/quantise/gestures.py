@@ -59,6 +59,7 @@ from scipy.signal import savgol_filter
 
 from ..body import joint_index
 from ..notation.model import LEVELS, PART_MIDDLE_JOINT, PART_SEGMENTS
+from .flight import landing_rest
 from .labels import DIRECTION_NAMES, FrameLabels
 from .measured import held_pose, hold_frames, keep_previous, trunk_tilt_beyond_noise, upright_trunk
 from .movement import Movement
@@ -331,7 +332,9 @@ def _key_pose_fn(
 ARRIVAL_DEPTH = 0.5
 
 
-def _weight_arrivals(joints: np.ndarray, supporting: np.ndarray) -> np.ndarray:
+def _weight_arrivals(
+    joints: np.ndarray, supporting: np.ndarray, flights=(), fps: float = 25.0, on_grid: np.ndarray | None = None
+) -> np.ndarray:
     """(T,) bool: frames where the weight arrives (clean motion).
 
     The pelvis moves with the supports only, each support movement in one
@@ -339,7 +342,10 @@ def _weight_arrivals(joints: np.ndarray, supporting: np.ndarray) -> np.ndarray:
     which starts from rest — slows to a minimum of its speed, where a
     support movement arrives.  That may be the very frame a leg gesture
     starts.  The weight arrives on a foot: in the air (`supporting`, (T, 2),
-    no foot) the pelvis's slowest frame is the top of its flight.
+    no foot) the pelvis's slowest frame is the top of its flight.  After
+    each of `flights` ((take-off, touchdown) frames) the landing arrives
+    where :func:`~.flight.landing_rest` says, not at the bottom of the dip
+    with which it absorbs the fall.
     """
     step = np.linalg.norm(np.diff(joints[:, joint_index("pelvis")], axis=0), axis=-1)
     out = np.zeros(len(joints), bool)
@@ -350,6 +356,10 @@ def _weight_arrivals(joints: np.ndarray, supporting: np.ndarray) -> np.ndarray:
     out[1:] = (step > 1e-9) & (nxt < step) & (nxt <= after)
     # A push that arrives slows to a fraction of its peak; a shallow dip is
     # not one (the unturned pelvis of a fast pirouette wobbles by a few cm/s).
+    for _, touchdown in flights:
+        rest = landing_rest(joints, touchdown, fps, on_grid)
+        out[touchdown:rest] = False
+        out[rest] = True
     speed, last = np.r_[step, 0.0], 0  # at rest after the clip
     for f in np.flatnonzero(out):
         if not speed[f] < ARRIVAL_DEPTH * speed[last:f].max(initial=0.0):
@@ -464,6 +474,7 @@ def gesture_movements(
     on_grid: np.ndarray | None = None,
     measured: bool = False,
     depth: np.ndarray | None = None,
+    flights=(),
 ) -> list[Movement]:
     """The gesture movements of the arms, legs, head and chest (module docstring).
 
@@ -482,6 +493,9 @@ def gesture_movements(
         One camera's horizontal line of sight in body axes
         (:func:`~.measured.depth_axes`): a measured chest's lean is then
         corrected and judged in depth only (:func:`~.measured.upright_trunk`).
+    flights : sequence of (int, int)
+        Take-off and touchdown frames of each flight
+        (:func:`~.flight.find_flights`).
 
     Returns
     -------
@@ -528,7 +542,9 @@ def gesture_movements(
             # the knee): it gestures only between leaving and reaching the floor.
             down = labels.supporting[:, _FOOT[part]]
             speed = np.where(down[:-1] & down[1:], 0.0, speed)
-        arrivals = _weight_arrivals(joints, labels.supporting) if clean and part in _FOOT else None
+        arrivals = (
+            _weight_arrivals(joints, labels.supporting, flights, fps, on_grid) if clean and part in _FOOT else None
+        )
         key = _key_pose_fn(labels, part, on_grid, arrivals=arrivals) if clean else None
         # Noisy motion: a shallower minimum parts two movements where the
         # part passes within _NEAR_POSE_DEG of a written pose.

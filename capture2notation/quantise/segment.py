@@ -263,7 +263,7 @@ def segment_motion(
         take_offs = np.zeros(T, bool)
         take_offs[[t0 for t0, _ in flights]] = True
         moves = (
-            gesture_movements(labels, joints, fps, params, on_grid, measured, depth)
+            gesture_movements(labels, joints, fps, params, on_grid, measured, depth, flights)
             + with_flights(
                 support_movements(
                     labels,

@@ -7,6 +7,7 @@ import numpy as np
 import synthetic.random_scores as random_scores
 from capture2notation.compare.agreement import score_differences
 from capture2notation.notation.facing import springs
+from capture2notation.notation.formats import loads
 from capture2notation.quantise.flight import find_flights
 from capture2notation.quantise.segment import segment_motion
 from synthetic.interpret import interpret
@@ -106,3 +107,21 @@ def test_a_fitted_flight_is_found_with_the_feet_floating_above_a_low_floor():
     assert len(airs) == len(want)
     for air in airs:  # each flight is followed by its landing support
         assert any(s.is_support and not s.is_air and s.start == air.end for s in seg.score.symbols)
+
+
+def test_a_leg_gesturing_through_a_flight_arrives_after_the_landing():
+    # Reference: the written score.  The right leg gestures from the
+    # take-off until the landing comes to rest (synthetic.flight: the landing
+    # absorbs in a dip below its height and rests at its end); the bottom of
+    # that dip, where the pelvis slows too, is not where the weight arrives,
+    # so the leg's movement is not cut there.
+    text = """tempo: 100
+0     2    support       place     low
+2     7/4  right_leg     left_back low
+2     1    support       air
+3     3/4  left_support  back      low
+15/4  3/2  support       place     middle
+"""
+    score = loads(text, "lab")
+    seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
+    assert score_differences(score, seg.score) == []

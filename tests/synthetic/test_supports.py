@@ -107,6 +107,35 @@ def test_a_foot_released_by_a_step_holds_its_leg():
     assert drift.max() < 1e-6, drift.max()
 
 
+def test_a_foot_released_twice_holds_the_pose_of_its_latest_release():
+    """Steps onto the left foot release the right one twice: each time the
+    right leg holds the pose it had when that step ended (it used to take
+    the first release's pose at the second, a 27° swing in one frame)."""
+    from capture2notation.body import body_frame, segment_vectors
+
+    score = Score(
+        (
+            _sym(0, F(1, 2), "left_support", "left_forward", "middle"),
+            _sym(1, 1, "right_support", "right", "middle"),
+            _sym(2, F(3, 4), "left_support", "left", "middle"),
+            _sym(F(11, 4), F(5, 4), "left_arm", "forward", "middle"),
+        ),
+        tempo=F(76),
+        meter=4,
+    )
+    m = interpret(score, 25.0)
+    J = m.joints()
+    v = segment_vectors(J, "right_hip", "right_ankle", body_frame(J))
+    ends = {s.part + str(s.start): (f0, f1) for s, f0, f1 in m.events}
+    for release, until in (("left_support0", "right_support1"), ("left_support2", None)):
+        a = ends[release][1]
+        b = ends[until][0] if until else len(J) - 1
+        assert b - a >= 5
+        held = v[a : b + 1]
+        drift = np.degrees(np.arctan2(np.linalg.norm(np.cross(held, v[a]), axis=-1), held @ v[a]))
+        assert drift.max() < 1e-6, (release, drift.max())
+
+
 def test_a_heel_lowered_slowly_steps_at_once_at_low_frame_rates():
     """A foot whose heel comes down from relevé slower than 0.2 m/s already
     rests when its step starts: it does not rest a frame more (at 12.5 fps
