@@ -565,8 +565,25 @@ def part_constants(joints, confidence, times, part: str, joint_names=JOINTS) -> 
 MAX_CURVE_POINTS = 48
 
 
+def _equal_bins(tau: np.ndarray, m: int) -> tuple[np.ndarray, int]:
+    """Bin index of each sample, and the number of bins: runs of `m` consecutive samples.
+
+    Bins never span a gap of lost frames (a step over 1.5 times the median);
+    a run of samples is cut into ceil(len / m) nearly equal blocks.
+    """
+    steps = np.diff(tau)
+    breaks = np.flatnonzero(steps > 1.5 * np.median(steps)) + 1 if steps.size else np.array([], int)
+    k = np.empty(tau.size, dtype=int)
+    n_bins = 0
+    for run in np.split(np.arange(tau.size), breaks):
+        for block in np.array_split(run, -(-run.size // m)):
+            k[block] = n_bins
+            n_bins += 1
+    return k, n_bins
+
+
 def resample_curve(curve: ProgressCurve, n_points: int = MAX_CURVE_POINTS) -> ProgressCurve:
-    """The curve averaged into at most `n_points` equal bins of τ (unchanged when it has no more samples).
+    """The curve averaged over runs of m consecutive frames, m = ceil(N / `n_points`) (unchanged when N ≤ `n_points`).
 
     Each bin holds the confidence-weighted means of its frames' τ, progress,
     radial and outward deviation, and the sum of their confidences divided
@@ -574,15 +591,21 @@ def resample_curve(curve: ProgressCurve, n_points: int = MAX_CURVE_POINTS) -> Pr
     k of them; weights stay in (0, 1]).  The likelihood's AR(1) correlation
     ρ is per median sample step (:class:`.likelihood.Batch`), so after
     resampling it is the correlation between neighbouring bins: the model
-    follows the new spacing without a change.  Empty bins (lost frames) are
-    left out, and the AR(1) chain then spans the gap as it does a gap of
-    frames.
+    follows the new spacing without a change.  That holds only if the bins
+    are alike: bins of equal width in τ held one or two frames each for a
+    curve of 49–95 frames (a two-beat movement at 60 bpm, 25 fps), spaced
+    irregularly and weighted 0.5 or 1 as if the noise were white, and the
+    90 % intervals of such movements covered 82 %.  So every bin takes
+    the same number of frames (a run's blocks differ by at most one), and a
+    bin never spans lost frames: the AR(1) chain spans the gap as it does a
+    gap of frames.
 
     Parameters
     ----------
     curve : ProgressCurve
     n_points : int
-        Most samples kept (≥ 4, :data:`MIN_FRAMES`).
+        Most samples kept (≥ 4, :data:`MIN_FRAMES`); a gap of lost frames
+        may add a bin.
 
     Returns
     -------
@@ -590,10 +613,10 @@ def resample_curve(curve: ProgressCurve, n_points: int = MAX_CURVE_POINTS) -> Pr
     """
     if n_points < MIN_FRAMES:
         raise EffortError(f"a curve needs at least {MIN_FRAMES} points, got n_points={n_points}")
-    if curve.tau.size <= n_points:
+    n = curve.tau.size
+    if n <= n_points:
         return curve
-    # which bin of [0, 1] each τ falls in: τ ∈ (0, 1), so every index is in range
-    k = np.minimum((curve.tau * n_points).astype(int), n_points - 1)
+    k, n_points = _equal_bins(curve.tau, -(-n // n_points))
     count = np.bincount(k, minlength=n_points)
     w = curve.weight
     wsum = np.bincount(k, w, n_points)

@@ -50,3 +50,28 @@ def test_lost_frames_leave_bins_out():
 def test_too_few_points_is_an_error():
     with pytest.raises(EffortError, match="n_points"):
         resample_curve(_curve(10), 2)
+
+
+def test_every_bin_holds_the_same_number_of_frames():
+    # 50 frames (two beats at 60 bpm, 25 fps) over 48 points: bins of two
+    # frames each, evenly spaced and equally weighted (equal-width bins of τ
+    # held one or two frames, weighted 0.5 or 1).
+    c = _curve(50)
+    r = resample_curve(c)
+    assert r.tau.size == 25
+    np.testing.assert_allclose(r.weight, 1.0)
+    np.testing.assert_allclose(np.diff(r.tau), 2 * np.diff(c.tau)[0])
+
+
+def test_no_bin_spans_lost_frames():
+    full = _curve(100)
+    keep = np.ones(100, bool)
+    keep[[30, 31, 32, 61]] = False
+    c = ProgressCurve(
+        full.part, 0.0, 1.0, full.tau[keep], full.s[keep], full.weight[keep], full.radial[keep], 1.0, None
+    )
+    r = resample_curve(c)
+    # A bin joining the frames on either side of a gap would sit on a lost frame's τ.
+    step = np.diff(full.tau)[0]
+    assert not np.any(np.abs(r.tau[:, None] - full.tau[~keep][None, :]) < 0.4 * step)
+    assert r.tau.size <= MAX_CURVE_POINTS + 2
