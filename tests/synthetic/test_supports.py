@@ -80,13 +80,26 @@ def test_a_gesturing_foot_leaves_the_floor_on_its_start(fps):
     assert sup[f0] and not sup[f0 + 1 : f0 + 4].any(), np.flatnonzero(sup)
 
 
+def _leg_and_events(score, side: str):
+    """Body-frame hip → ankle vectors of one leg, each symbol's (start, end) frames keyed part + start, T."""
+    from capture2notation.body import body_frame, segment_vectors
+
+    m = interpret(score, 25.0)
+    J = m.joints()
+    v = segment_vectors(J, f"{side}_hip", f"{side}_ankle", body_frame(J))
+    return v, {s.part + str(s.start): (f0, f1) for s, f0, f1 in m.events}, len(J)
+
+
+def _drift_deg(v: np.ndarray) -> float:
+    """Largest angle (degrees) of the vectors `v` (N, 3) from the first."""
+    return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(v, v[0]), axis=-1), v @ v[0])).max())
+
+
 def test_a_foot_released_by_a_step_holds_its_leg():
     """After a step onto the right foot the left foot is free and unnotated:
     its leg holds its body-frame pose while the right foot rises to relevé
     (it used to reach for the spot it left, drifting 2° — an unwritten
     gesture for the quantiser)."""
-    from capture2notation.body import body_frame, segment_vectors
-
     score = Score(
         (
             _sym(0, F(1, 2), "right_support", "back", "middle"),
@@ -97,22 +110,16 @@ def test_a_foot_released_by_a_step_holds_its_leg():
         tempo=F(101),
         meter=4,
     )
-    m = interpret(score, 25.0)
-    J = m.joints()
-    v = segment_vectors(J, "left_hip", "left_ankle", body_frame(J))
-    ends = {s.part + str(s.start): (f0, f1) for s, f0, f1 in m.events}
+    v, ends, _ = _leg_and_events(score, "left")
     a, b = ends["right_support0"][1], ends["left_leg2"][0]
     assert b - a > 10
-    drift = np.degrees(np.arctan2(np.linalg.norm(np.cross(v[a : b + 1], v[a]), axis=-1), v[a : b + 1] @ v[a]))
-    assert drift.max() < 1e-6, drift.max()
+    assert _drift_deg(v[a : b + 1]) < 1e-6
 
 
 def test_a_foot_released_twice_holds_the_pose_of_its_latest_release():
     """Steps onto the left foot release the right one twice: each time the
     right leg holds the pose it had when that step ended (it used to take
     the first release's pose at the second, a 27° swing in one frame)."""
-    from capture2notation.body import body_frame, segment_vectors
-
     score = Score(
         (
             _sym(0, F(1, 2), "left_support", "left_forward", "middle"),
@@ -123,17 +130,12 @@ def test_a_foot_released_twice_holds_the_pose_of_its_latest_release():
         tempo=F(76),
         meter=4,
     )
-    m = interpret(score, 25.0)
-    J = m.joints()
-    v = segment_vectors(J, "right_hip", "right_ankle", body_frame(J))
-    ends = {s.part + str(s.start): (f0, f1) for s, f0, f1 in m.events}
+    v, ends, T = _leg_and_events(score, "right")
     for release, until in (("left_support0", "right_support1"), ("left_support2", None)):
         a = ends[release][1]
-        b = ends[until][0] if until else len(J) - 1
+        b = ends[until][0] if until else T - 1
         assert b - a >= 5
-        held = v[a : b + 1]
-        drift = np.degrees(np.arctan2(np.linalg.norm(np.cross(held, v[a]), axis=-1), held @ v[a]))
-        assert drift.max() < 1e-6, (release, drift.max())
+        assert _drift_deg(v[a : b + 1]) < 1e-6, release
 
 
 def test_a_heel_lowered_slowly_steps_at_once_at_low_frame_rates():
