@@ -333,7 +333,7 @@ ARRIVAL_DEPTH = 0.5
 
 
 def _weight_arrivals(
-    joints: np.ndarray, supporting: np.ndarray, flights=(), fps: float = 25.0, on_grid: np.ndarray | None = None
+    joints: np.ndarray, supporting: np.ndarray, flights, fps: float, on_grid: np.ndarray | None
 ) -> np.ndarray:
     """(T,) bool: frames where the weight arrives (clean motion).
 
