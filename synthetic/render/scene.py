@@ -382,5 +382,35 @@ def _fill_world_polygon(img, camera: Camera, corners: np.ndarray, colour) -> Non
     if len(out) < 3:
         return
     pix = _cam_to_pix(camera, np.array(out))
-    pix = np.clip(pix, -(2**14), 2**14)
+    # Points just beyond the near plane project millions of pixels away: cut
+    # the polygon to a frame around the image (clamping each coordinate
+    # instead bends its edges, and a camera pitched up saw the floor drawn
+    # above the horizon).
+    pix = _clip_to_box(pix, -_FILL_MARGIN_PX, np.array(camera.size, float) + _FILL_MARGIN_PX)
+    if len(pix) < 3:
+        return
     cv2.fillPoly(img, [np.round(pix * 16).astype(np.int32)], colour, cv2.LINE_AA, 4)
+
+
+#: Margin (pixels) around the image to which filled polygons are cut.
+_FILL_MARGIN_PX = 64.0
+
+
+def _clip_to_box(poly: np.ndarray, lo, hi) -> np.ndarray:
+    """A convex polygon ``(N, 2)`` cut to the box ``lo <= p <= hi`` (Sutherland–Hodgman)."""
+    lo = np.broadcast_to(np.asarray(lo, float), (2,))
+    hi = np.broadcast_to(np.asarray(hi, float), (2,))
+    pts = [np.asarray(p, float) for p in poly]
+    for axis in (0, 1):
+        for bound, inside in ((lo[axis], lambda v, b: v >= b), (hi[axis], lambda v, b: v <= b)):
+            kept = []
+            for i, p in enumerate(pts):
+                q = pts[(i + 1) % len(pts)]
+                if inside(p[axis], bound):
+                    kept.append(p)
+                if inside(p[axis], bound) != inside(q[axis], bound):
+                    kept.append(p + (q - p) * (bound - p[axis]) / (q[axis] - p[axis]))
+            pts = kept
+            if not pts:
+                return np.empty((0, 2))
+    return np.array(pts)

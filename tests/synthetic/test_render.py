@@ -307,3 +307,40 @@ def test_mannequin_shirt_has_a_v_neck_only_at_the_front():
     u, v = np.round(cam.project(np.array([0.0, 0.05, 0.79]) * BODY.height)).astype(int)
     green = [int(make_renderer(p, cam, "mannequin").frame(0)[v, u, 1]) for p in (front, back)]
     assert green[0] > 110 and green[1] < 100  # skin (G ≈ 144) in front, red shirt (G ≈ 64) behind
+
+
+@pytest.mark.parametrize(
+    ("height", "pitch", "roll"), [(0.5, 10.0, 5.0), (1.6, -15.0, 0.0), (2.0, 17.5, 2.5), (1.0, 0.0, -8.0)]
+)
+def test_the_floor_is_drawn_below_the_horizon_for_any_phone_camera(height, pitch, roll):
+    # Reference: geometry.  A level floor seen by an upright camera lies
+    # below the horizon: the top corners show the wall, the bottom ones the
+    # floor (a camera pitched up had the floor drawn above the horizon).
+    from synthetic.render.camera import Camera
+    from synthetic.render.scene import floor_background
+
+    wall, floor = (236, 232, 226), (196, 204, 212)
+    cam = Camera.phone("front", (640, 480), 1.7, height=height, pitch_deg=pitch, roll_deg=roll, hfov_deg=65.0)
+    img = floor_background(cam, wall=wall, floor=floor)
+    for y, x in ((0, 0), (0, 639)):
+        np.testing.assert_array_equal(img[y, x], wall)
+    for y, x in ((479, 2), (479, 637)):  # clear of the grid lines' column at the edge
+        assert np.abs(img[y, x].astype(int) - floor).max() <= 30
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.tuples(st.floats(-1e7, 1e7), st.floats(-1e7, 1e7)), min_size=3, max_size=8),
+)
+def test_polygons_are_cut_to_the_box_without_leaving_it(points):
+    from synthetic.render.scene import _clip_to_box
+
+    hull = cv2.convexHull(np.array(points, np.float32).reshape(-1, 1, 2)).reshape(-1, 2).astype(float)
+    cut = _clip_to_box(hull, -64.0, np.array([704.0, 544.0]))
+    assert np.all(cut >= -64.0 - 1e-6) and np.all(cut <= np.array([704.0, 544.0]) + 1e-6)
+    # A box corner is inside the cut polygon exactly when it is inside the hull.
+    if len(cut) >= 3:
+        for corner in ((-64.0, -64.0), (704.0, 544.0)):
+            inside_hull = cv2.pointPolygonTest(hull.astype(np.float32).reshape(-1, 1, 2), corner, True) > 1e-3
+            if inside_hull:
+                assert cv2.pointPolygonTest(cut.astype(np.float32).reshape(-1, 1, 2), corner, True) >= -1e-2
