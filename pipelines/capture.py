@@ -15,7 +15,8 @@ written atomically into OUTDIR:
 ``labels.csv``      per-frame labels of every part
 ``staff.svg/.png``  the Labanotation staff (a long one continues on
                     ``staff-2.png``, … pages)
-``capture.npz``     keypoints (video input), fitted joints (T, J, 3), angles,
+``capture.npz``     the input's kind (``input_kind``), keypoints (video
+                    input), fitted joints (T, J, 3), angles,
                     confidence (T, J), fps, times; for video the camera
                     estimate with its uncertainty (``camera_estimate``,
                     JSON) and which camera the fit used (``camera_source``)
@@ -557,7 +558,7 @@ def notate(
         if effort:
             t0 = time.perf_counter()
             try:
-                files.update(_write_effort(stage, seg.score, motion, seed, workers))
+                files.update(_write_effort(stage, seg.score, motion, seed, workers, fitted=is_fitted(kind)))
             except C2NError as exc:
                 # Effort is an addition to the notation: report, keep the rest.
                 skipped.append(f"effort.json: {exc}")
@@ -624,15 +625,16 @@ def _write_outputs(outdir: Path, seg: Segmentation, motion, track, kind: str, ca
     # a long staff continues on further PNG pages: staff-2.png, ...
     for page in sorted(outdir.glob("staff*.png")):
         files[page.name] = page
-    files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track, *camera)
+    files["capture.npz"] = _write_npz(outdir / "capture.npz", motion, track, *camera, input_kind=kind)
     if kind not in ("video", "multiview"):
         skipped.append(f"overlay.mp4: no video ({kind} input)")
     return files, skipped
 
 
-def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = "") -> Path:
+def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = "", input_kind: str = "") -> Path:
     T = np.asarray(motion.joints).shape[0]
     arrays = {
+        "input_kind": np.asarray(input_kind),
         "fps": np.asarray(float(motion.fps)),
         "times": np.asarray(motion.times, float),
         "joint_names": np.asarray(JOINTS),
@@ -656,7 +658,25 @@ def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = ""
     return path
 
 
-def _write_effort(outdir: Path, score: Score, motion, seed: int, workers: int = 1) -> dict:
+def is_fitted(kind: str) -> bool:
+    """Whether an input of `kind` (:func:`input_kind`, or ``multiview``) is fitted to a pose model's keypoints.
+
+    A fitted capture's joint error is smooth from frame to frame, so its
+    Effort takes the fitted-capture prior on the residuals' correlation
+    (:data:`~capture2notation.effort.likelihood.CAPTURE_RHO_RANGE`);
+    motion files keep the default prior.
+    """
+    return kind in (*FITTED_KINDS, "multiview")
+
+
+def effort_sampler_options(fitted: bool) -> dict:
+    """``sampler_kw`` of :func:`~capture2notation.effort.estimate_effort` for a fitted capture or a motion file."""
+    from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
+
+    return {"rho_range": CAPTURE_RHO_RANGE} if fitted else {}
+
+
+def _write_effort(outdir: Path, score: Score, motion, seed: int, workers: int = 1, fitted: bool = False) -> dict:
     from capture2notation.effort import estimate_effort, write_effort
 
     result = estimate_effort(
@@ -667,6 +687,7 @@ def _write_effort(outdir: Path, score: Score, motion, seed: int, workers: int = 
         rng=np.random.default_rng(seed),
         times=motion.times,
         workers=workers,
+        sampler_kw=effort_sampler_options(fitted),
     )
     paths = write_effort(result, outdir, plots=True, rng=seed)
     return {Path(p).name: Path(p) for p in paths.values()}

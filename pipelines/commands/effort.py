@@ -26,6 +26,8 @@ SCORE_LAB = "score.lab"
 def load_capture(path) -> dict:
     """Joints, confidence, fps, times and joint names from a ``capture.npz``.
 
+    Also whether the capture was fitted to keypoints (``fitted``: its
+    ``input_kind``; a file without one is fitted when it holds keypoints).
     Tolerant of optional keys: ``confidence`` defaults to 1 where the joint
     is finite (0 where NaN), ``times`` to ``arange(T) / fps``, ``fps`` to
     the median frame interval of ``times``, ``joint_names`` to the canonical
@@ -66,12 +68,20 @@ def load_capture(path) -> dict:
     if times.shape != (t_count,):
         raise PipelineError(f"{path}: 'times' must have T = {t_count} entries, got {times.shape}")
     names = tuple(str(n) for n in data["joint_names"]) if "joint_names" in data else JOINTS
-    return {"joints": joints, "confidence": conf, "fps": fps, "times": times, "joint_names": names}
+    if "input_kind" in data:
+        from pipelines.capture import is_fitted
+
+        fitted = is_fitted(str(data["input_kind"]))
+    else:
+        # Written before the kind was recorded: a video's capture holds its keypoints.
+        fitted = "keypoints" in data and bool(np.isfinite(np.asarray(data["keypoints"], dtype=float)).any())
+    return {"joints": joints, "confidence": conf, "fps": fps, "times": times, "joint_names": names, "fitted": fitted}
 
 
 def run_effort(capture_dir, seed: int = 0, workers: int = 2, plots: bool = True):
     """Estimate and write Effort for one capture folder; returns (result, paths)."""
     from capture2notation.notation import read
+    from pipelines.capture import effort_sampler_options
 
     capture_dir = Path(capture_dir)
     cap = load_capture(capture_dir / CAPTURE_NPZ)
@@ -88,6 +98,7 @@ def run_effort(capture_dir, seed: int = 0, workers: int = 2, plots: bool = True)
         times=cap["times"],
         joint_names=cap["joint_names"],
         workers=workers,
+        sampler_kw=effort_sampler_options(cap["fitted"]),
     )
     paths = write_effort(result, capture_dir, plots=plots, rng=seed)
     return result, paths

@@ -19,7 +19,7 @@ from capture2notation.body import JOINTS, Body
 from capture2notation.compare.agreement import score_differences
 from capture2notation.errors import PipelineError
 from capture2notation.io.truth import write_truth
-from capture2notation.notation import read
+from capture2notation.notation import read, write
 from capture2notation.notation.model import Score, Symbol
 from capture2notation.quantise.labels import LABEL_PARTS
 from pipelines.capture import capture, input_kind
@@ -87,6 +87,7 @@ def test_truth_sidecar_capture_writes_every_file(sidecar, tmp_path):
         assert z["confidence"].shape == (res.n_frames, len(JOINTS))
         assert float(z["fps"]) == 25.0
         assert np.all(np.isnan(z["keypoints"]))  # no video: no keypoints, none invented
+        assert str(z["input_kind"]) == "truth"
     page = (out / "index.html").read_text()
     assert '<svg id="staff"' in page and 'href="staff.svg"' in page and "motion file" in page
     assert any("overlay.mp4" in s for s in res.skipped)
@@ -218,6 +219,7 @@ def test_rendered_video_through_markers_backend(marker_render, calibrated, tmp_p
     assert res.kind == "video" and res.track is not None
     assert (tmp_path / "c" / "overlay.mp4").stat().st_size > 0
     with np.load(tmp_path / "c" / "capture.npz") as z:
+        assert str(z["input_kind"]) == "video"
         assert z["keypoints"].shape == (res.n_frames, 33, 3)
         assert (
             np.isfinite(z["keypoints"][:, 16, :2]).all(axis=1).mean() > 0.9
@@ -535,3 +537,49 @@ def test_an_overlay_that_fails_beside_the_notation_fails_the_capture_and_leaves_
         capture(marker_render / "video.mp4", tmp_path / "c", backend="markers", tempo=90, progress=False, effort=False)
     assert not (tmp_path / "c").exists()
     assert not list(tmp_path.glob(".c.partial-*"))
+
+
+def test_fitted_captures_take_the_fitted_capture_prior_for_effort(tmp_path, monkeypatch):
+    """Video, keypoint tracks and several cameras are fitted to a pose model's
+    keypoints, whose joint error is smooth: their Effort takes
+    ``CAPTURE_RHO_RANGE``; motion files keep the default prior.  ``c2n
+    effort DIR`` reads which from ``capture.npz`` (an older file without
+    ``input_kind``: fitted when it holds keypoints)."""
+    import importlib
+
+    from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
+    from pipelines.capture import effort_sampler_options, is_fitted
+
+    assert [is_fitted(k) for k in ("video", "keypoints", "multiview")] == [True, True, True]
+    assert [is_fitted(k) for k in ("bvh", "kinect", "truth")] == [False, False, False]
+    assert effort_sampler_options(True) == {"rho_range": CAPTURE_RHO_RANGE}
+    assert effort_sampler_options(False) == {}
+
+    command = importlib.import_module("pipelines.commands.effort")
+    T = 30
+    base = {"joints": np.zeros((T, len(JOINTS), 3)), "fps": np.float64(25.0)}
+    cases = {
+        "video": ({"input_kind": np.asarray("video")}, True),
+        "bvh": ({"input_kind": np.asarray("bvh")}, False),
+        "old video": ({"keypoints": np.ones((T, 33, 3))}, True),
+        "old motion file": ({"keypoints": np.full((T, 33, 3), np.nan)}, False),
+        "bare": ({}, False),
+    }
+    for name, (extra, fitted) in cases.items():
+        np.savez(tmp_path / f"{name}.npz", **base, **extra)
+        assert command.load_capture(tmp_path / f"{name}.npz")["fitted"] is fitted, name
+
+    seen = {}
+
+    def fake_estimate(*args, sampler_kw=None, **kwargs):
+        seen["sampler_kw"] = sampler_kw
+        raise RuntimeError("stop here")
+
+    monkeypatch.setattr(command, "estimate_effort", fake_estimate)
+    folder = tmp_path / "cap"
+    folder.mkdir()
+    np.savez(folder / "capture.npz", **base, input_kind=np.asarray("keypoints"))
+    write(EXPECTED, folder / "score.lab")
+    with pytest.raises(RuntimeError, match="stop here"):
+        command.run_effort(folder, workers=1, plots=False)
+    assert seen["sampler_kw"] == {"rho_range": CAPTURE_RHO_RANGE}
