@@ -1,6 +1,6 @@
 """The whole path on phrases kept out of development: accuracy and speed.
 
-Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phrases DIR | --random N [--first-seed S]] [--explain]``.
+Run ``python benchmarks/bench_wholepath.py [--view front|45|side] [--phone H,PITCH,ROLL,HFOV] [--phrases DIR | --random N [--first-seed S]] [--explain]``.
 
 Each phrase (``benchmarks/holdout/*.lab`` by default: eight phrases of arms,
 legs and supports written for this measurement and never used to tune the
@@ -114,8 +114,14 @@ def measure(
     flip_test: bool | None = None,
     keypoints: str = "blazepose",
     calibrated: bool = False,
+    phone: tuple[float, float, float, float] | None = None,
 ) -> dict:
-    """Render one phrase, capture it from truth and from video, compare; see the module docstring."""
+    """Render one phrase, capture it from truth and from video, compare; see the module docstring.
+
+    `phone` = (height m, pitch °, roll °, horizontal field of view °): render
+    through :meth:`synthetic.render.camera.Camera.phone` on `view`'s azimuth
+    instead of the view's preset camera.
+    """
     from capture2notation.compare.agreement import agreement_cells, compare_scores
     from capture2notation.compare.metrics import mpjpe
     from capture2notation.io.truth import read_truth
@@ -125,9 +131,16 @@ def measure(
     from synthetic.render import render_score
 
     score = read(path)
+    camera = None
+    if phone is not None:
+        from synthetic.render.camera import Camera as RenderCamera
+
+        h, pitch, roll, hfov = phone
+        camera = RenderCamera.phone(view, (640, 480), height=h, pitch_deg=pitch, roll_deg=roll, hfov_deg=hfov)
     render = render_score(
-        score, workdir / "render", fps=25.0, size=(640, 480), view=view, style="mannequin", progress=False
-    )
+        score, workdir / "render", fps=25.0, size=(640, 480), view=view, style="mannequin", progress=False,
+        camera=camera,
+    )  # fmt: skip
     from_truth = capture(render / "truth.npz", workdir / "truth", tempo=score.tempo, progress=False, effort=False)
     exact = compare_scores(score, from_truth.score).exact
     truth = read_truth(render / "truth.npz")
@@ -212,6 +225,14 @@ def main() -> None:
         help="give the capture the renderer's true camera (--calibration camera.toml); "
         "by default it sees only the video, as a user's capture does",
     )
+    ap.add_argument(
+        "--phone",
+        type=_phone,
+        default=None,
+        metavar="H,PITCH,ROLL,HFOV",
+        help="render through a phone camera: height m, pitch and roll degrees, horizontal field of view degrees "
+        "(e.g. 0.5,10,0,65), as `c2n render --camera-height --pitch --roll --hfov`",
+    )
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -226,6 +247,7 @@ def main() -> None:
                 args.flip_test,
                 args.keypoints,
                 args.calibrated,
+                args.phone,
             )
             rows.append(r)
             print(
@@ -260,6 +282,17 @@ def main() -> None:
     print(
         "  agreement by column                   " + ", ".join(f"{p} {1 - lost[p] / n:.0%}" for p, n in total.items())
     )
+
+
+def _phone(text: str) -> tuple[float, float, float, float]:
+    """``H,PITCH,ROLL,HFOV`` → four floats (argparse type)."""
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"expected H,PITCH,ROLL,HFOV (four numbers), got {text!r}")
+    return values  # type: ignore[return-value]
 
 
 def _random_phrases(args, folder: Path) -> list[Path]:
