@@ -616,14 +616,14 @@ def resample_curve(curve: ProgressCurve, n_points: int = MAX_CURVE_POINTS) -> Pr
     n = curve.tau.size
     if n <= n_points:
         return curve
-    k, n_points = _equal_bins(curve.tau, -(-n // n_points))
-    count = np.bincount(k, minlength=n_points)
+    # Every bin holds at least one sample.
+    k, n_bins = _equal_bins(curve.tau, -(-n // n_points))
+    count = np.bincount(k, minlength=n_bins)
     w = curve.weight
-    wsum = np.bincount(k, w, n_points)
-    full = count > 0
+    wsum = np.bincount(k, w, n_bins)
 
     def mean(v):
-        return (np.bincount(k, w * v, n_points) / np.where(full, wsum, 1.0))[full]
+        return np.bincount(k, w * v, n_bins) / wsum
 
     return ProgressCurve(
         part=curve.part,
@@ -631,7 +631,7 @@ def resample_curve(curve: ProgressCurve, n_points: int = MAX_CURVE_POINTS) -> Pr
         t_end=curve.t_end,
         tau=mean(curve.tau),
         s=mean(curve.s),
-        weight=wsum[full] / count.max(),
+        weight=wsum / count.max(),
         radial=mean(curve.radial),
         angle=curve.angle,
         outward=None if curve.outward is None else mean(curve.outward),

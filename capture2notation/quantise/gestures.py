@@ -354,12 +354,12 @@ def _weight_arrivals(
     nxt = np.r_[step[1:], 0.0]
     after = np.r_[step[2:], np.inf, np.inf]
     out[1:] = (step > 1e-9) & (nxt < step) & (nxt <= after)
-    # A push that arrives slows to a fraction of its peak; a shallow dip is
-    # not one (the unturned pelvis of a fast pirouette wobbles by a few cm/s).
     for _, touchdown in flights:
         rest = landing_rest(joints, touchdown, fps, on_grid)
         out[touchdown:rest] = False
         out[rest] = True
+    # A push that arrives slows to a fraction of its peak; a shallow dip is
+    # not one (the unturned pelvis of a fast pirouette wobbles by a few cm/s).
     speed, last = np.r_[step, 0.0], 0  # at rest after the clip
     for f in np.flatnonzero(out):
         if not speed[f] < ARRIVAL_DEPTH * speed[last:f].max(initial=0.0):
