@@ -6,6 +6,9 @@ model alone, the way MediaPipe tracks between frames
 (``pose_landmark_cpu.pbtxt``):
 
 1. *acquire*: run the model on the whole frame, letterboxed to a square;
+   when it finds no one there (a person under about half the frame's
+   height), search square crops over the frame, largest first
+   (:func:`search_crops`), at most once every ``SEARCH_INTERVAL_S`` on video;
 2. *refine*: the auxiliary points 33 (hip centre) and 34 (full-body scale
    point) define the next crop as in ``PoseLandmarksToRoi``
    (``AlignmentPointsRectsCalculator`` then ``RectTransformationCalculator``):
@@ -51,6 +54,7 @@ __all__ = [
     "decode_outputs",
     "full_frame_crop",
     "make_session",
+    "search_crops",
 ]
 
 logger = logging.getLogger(__name__)
@@ -60,6 +64,19 @@ NUM_ALL = 39  # 33 body landmarks + aux 33, 34 + 4 unused
 ROI_SCALE = 1.25  # RectTransformationCalculator scale_x/scale_y in PoseLandmarksToRoi
 PRESENCE_THRESHOLD = 0.5  # ThresholdingCalculator in the pose graph
 MIN_CROP_PX = 16.0  # smaller crops are upsampled noise: re-acquire instead
+#: Sides of the searched crops, as fractions of the frame's shorter side.  The
+#: landmark model finds a person who fills about half its crop's height or
+#: more (a 190-px figure: pose present 1.0 in a 360-px crop, 0.01 in a 480-px
+#: one), so a 640x480 frame searched at these sides finds people from about
+#: 110 px tall; the letterboxed full frame finds those over about half its side.
+SEARCH_SCALES = (0.75, 0.5)
+#: Neighbouring searched crops overlap by half their side, so a person who
+#: fits in one crop's middle is never cut by every crop.
+SEARCH_STEP = 0.5
+#: While no one is found on video, the crops are searched at most this often
+#: (seconds of video): a search costs about twenty model runs (640x480), so a
+#: clip with nobody in it runs at most about twice the cost of tracking.
+SEARCH_INTERVAL_S = 1.0
 #: A frame is flipped back when its mirrored labelling lies nearer the previous
 #: frame by more than this fraction of the person's size (summed over the 11
 #: body pairs).  Measured between consecutive frames that are not flipped:
@@ -166,6 +183,36 @@ def full_frame_crop(width: int, height: int) -> np.ndarray:
     """The square crop that letterboxes the whole frame: (cx, cy, side, side, 0)."""
     side = float(max(width, height))
     return np.array([width / 2.0, height / 2.0, side, side, 0.0])
+
+
+def search_crops(width: int, height: int, scales=SEARCH_SCALES) -> list[np.ndarray]:
+    """Square crops covering the frame at each of `scales`, for finding a small person.
+
+    Parameters
+    ----------
+    width, height : int
+        Frame size, pixels.
+    scales : sequence of float
+        Crop sides as fractions of ``min(width, height)``, searched in order.
+
+    Returns
+    -------
+    list of (N_s, 5) ndarray
+        Per scale, the crops (cx, cy, side, side, 0) in pixels, overlapping by
+        ``SEARCH_STEP`` of their side and covering the whole frame.
+    """
+    out = []
+    for scale in scales:
+        side = float(scale) * min(width, height)
+        centres = []
+        for extent in (width, height):
+            n = max(1, int(np.ceil((extent - side) / (SEARCH_STEP * side) - 1e-9)) + 1)
+            centres.append(np.linspace(side / 2.0, max(side / 2.0, extent - side / 2.0), n))
+        cx, cy = np.meshgrid(*centres)
+        crops = np.zeros((cx.size, 5))
+        crops[:, 0], crops[:, 1], crops[:, 2:4] = cx.ravel(), cy.ravel(), side
+        out.append(crops)
+    return out
 
 
 def crop_from_aux(aux: np.ndarray, scale: float = ROI_SCALE) -> np.ndarray:
@@ -336,7 +383,12 @@ class BlazePose:
         self.reset()
 
     def reset(self) -> None:
-        """Forget the tracked crop and the filters (call between videos)."""
+        """Forget the tracked crop, the filters and the search clock (call between videos)."""
+        self._next_search = -np.inf  # video time (s) from which the crops may be searched again
+        self._lose()
+
+    def _lose(self) -> None:
+        """Forget the tracked crop and the filters (the person was lost)."""
         self._crop = None
         self._previous = None  # last returned image landmarks (33, 3), left/right consistent
         self._f_xy = OneEuroFilter(*POSE_FILTER)
@@ -360,11 +412,29 @@ class BlazePose:
             return est
         return average_estimates(est, other)
 
-    def estimate_image(self, image: np.ndarray) -> PoseEstimate:
-        """Locate the person in a still image: full frame, then refined crops."""
+    def estimate_image(self, image: np.ndarray, search: bool = True) -> PoseEstimate:
+        """Locate the person in a still image: full frame, searched crops, then refined crops.
+
+        Parameters
+        ----------
+        image : (H, W, 3) uint8 ndarray
+            BGR frame.
+        search : bool
+            When the whole frame shows no one, search :func:`search_crops`
+            (largest first; the most confident crop of the first side that
+            finds someone).
+        """
         if image.ndim != 3 or image.shape[2] != 3:
             raise KeypointError(f"expected a BGR image (H, W, 3), got shape {image.shape}")
-        est = self.infer(image, full_frame_crop(image.shape[1], image.shape[0]))
+        height, width = image.shape[:2]
+        est = self.infer(image, full_frame_crop(width, height))
+        if est.presence < self.presence_threshold and search:
+            for crops in search_crops(width, height):
+                best = max((self.infer(image, crop) for crop in crops), key=lambda e: e.presence)
+                if best.presence >= self.presence_threshold:
+                    logger.debug("person found in a %.0f-px crop at (%.0f, %.0f)", *best.crop[[2, 0, 1]])
+                    est = best
+                    break
         for _ in range(self.refinements):
             crop = crop_from_aux(est.aux)
             if est.presence < self.presence_threshold or not _usable(crop):
@@ -394,8 +464,11 @@ class BlazePose:
                 logger.debug("t=%.3f s: pose lost (score %.2f), re-acquiring", t, est.presence)
                 est = None
         if est is None:
-            self.reset()
-            est = self.estimate_image(image)
+            self._lose()
+            search = t >= self._next_search
+            if search:
+                self._next_search = t + SEARCH_INTERVAL_S
+            est = self.estimate_image(image, search=search)
             if est.presence < self.presence_threshold:
                 return None
         if self.fix_swaps and self._previous is not None:

@@ -72,3 +72,55 @@ def test_tracking_follows_a_moving_person(fixture_path, blazepose):
     track = extract_frames(frames, fps=30.0, estimator=blazepose, smooth=False)
     hips = track.xy[:, 23:25, 0].mean(axis=1)
     np.testing.assert_allclose(hips - hips[0], shifts, atol=6.0)
+
+
+def _small_in_corner(image, factor):
+    """`image` shrunk by `factor` into the bottom-right corner of a grey frame of its size."""
+    small = cv2.resize(image, None, fx=factor, fy=factor, interpolation=cv2.INTER_AREA)
+    frame = np.full_like(image, 200)
+    h, w = small.shape[:2]
+    H, W = image.shape[:2]
+    frame[H - h - 5 : H - 5, W - w - 5 : W - 5] = small
+    return frame, np.array([W - w - 5, H - h - 5], dtype=float)
+
+
+def test_small_person_found_by_searching_crops(fixture_path, blazepose):
+    """A person a fifth of the frame's height is missed by the whole frame and found by the search."""
+    image = cv2.imread(str(fixture_path("mediapipe/pose.jpg")))
+    ref = blazepose.estimate_image(image).xy[:, :2]
+    frame, offset = _small_in_corner(image, 0.35)
+    assert blazepose.estimate_image(frame, search=False).presence < 0.5
+    est = blazepose.estimate_image(frame)
+    assert est.presence > 0.9
+    # MediaPipe's own tolerance on pose.jpg is 15 px at full size; scaled, ~5 px.
+    err = np.linalg.norm(est.xy[:, :2] - (ref * 0.35 + offset), axis=1)
+    assert np.median(err) < 5.0
+
+
+def test_search_runs_at_a_bounded_rate(fixture_path, blazepose_session):
+    """While nobody is in the frame, crops are searched once per SEARCH_INTERVAL_S, not every frame."""
+    from capture2notation.keypoints.blazepose import SEARCH_INTERVAL_S, BlazePose, search_crops
+
+    calls = []
+
+    class Counting:
+        def __init__(self, session):
+            self._session = session
+
+        def get_inputs(self):
+            return self._session.get_inputs()
+
+        def run(self, *args, **kwargs):
+            calls.append(1)
+            return self._session.run(*args, **kwargs)
+
+    est = BlazePose(session=Counting(blazepose_session))
+    image = cv2.imread(str(fixture_path("mediapipe/pose.jpg")))
+    blank = np.full_like(image, 127)
+    fps, seconds = 10.0, 2.0
+    n = int(fps * seconds)
+    track = extract_frames([blank + (i % 2) for i in range(n)], fps=fps, estimator=est)
+    assert (track.presence == 0).all()
+    per_search = sum(len(c) for c in search_crops(image.shape[1], image.shape[0]))
+    searches = int(np.ceil(seconds / SEARCH_INTERVAL_S))
+    assert len(calls) == n + searches * per_search

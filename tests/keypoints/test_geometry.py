@@ -14,6 +14,7 @@ from capture2notation.keypoints.blazepose import (
     crop_to_tensor,
     decode_outputs,
     full_frame_crop,
+    search_crops,
 )
 
 crops = st.tuples(st.floats(-200, 1200), st.floats(-200, 900), st.floats(20, 2000), st.floats(-np.pi, np.pi)).map(
@@ -81,3 +82,19 @@ def test_degenerate_aux_points_give_an_unusable_crop():
     assert not _usable(crop_from_aux(np.array([[10.0, 10.0], [10.0, 10.0]])))
     assert not _usable(crop_from_aux(np.array([[np.nan, 10.0], [10.0, 10.0]])))
     assert _usable(crop_from_aux(np.array([[10.0, 100.0], [10.0, 60.0]])))
+
+
+@given(st.integers(32, 4000), st.integers(32, 4000), st.floats(0.1, 1.0))
+@settings(max_examples=200, deadline=None)
+def test_search_crops_cover_the_frame_inside_it(width, height, scale):
+    """Every searched crop lies inside the frame; together they cover it with half-side steps."""
+    (crops,) = search_crops(width, height, scales=(scale,))
+    side = scale * min(width, height)
+    np.testing.assert_allclose(crops[:, 2:4], side)
+    assert (crops[:, 4] == 0).all()
+    lo, hi = crops[:, :2] - side / 2, crops[:, :2] + side / 2
+    assert (lo >= -1e-6).all() and (hi <= np.array([width, height]) + 1e-6).all()
+    for axis, extent in enumerate((width, height)):
+        centres = np.unique(crops[:, axis].round(6))
+        assert centres[0] - side / 2 < 1e-6 and centres[-1] + side / 2 > extent - 1e-6
+        assert (np.diff(centres) <= 0.5 * side + 1e-6).all()
