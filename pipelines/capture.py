@@ -186,6 +186,25 @@ def _with_fps(motion, fps: float):
     return motion.replace(fps=float(fps), times=np.arange(T) / float(fps))
 
 
+#: Largest camera roll the fit takes from the estimate, degrees.  Phones on a
+#: tripod or a table are rolled up to about 10°; the estimate reads roll from
+#: the trunk's image direction, so a larger one is more likely a dancer's
+#: lasting side lean than the camera.
+MAX_ROLL_DEG = 20.0
+
+
+def _estimate_camera(track, seed: int):
+    """The camera from the person (:func:`~capture2notation.fitting.camera_estimate.estimate_camera`), or None."""
+    from capture2notation.fitting.camera_estimate import estimate_camera
+
+    try:
+        return estimate_camera(track.xy, track.visibility, track.world, track.image_size, seed=seed)
+    except (C2NError, ValueError, np.linalg.LinAlgError) as exc:
+        # The estimate is a report beside the fit (and its roll a refinement): say so and go on.
+        log.warning("capture: camera not estimated: %s", exc)
+        return None
+
+
 def load_motion(
     path,
     kind: str,
@@ -196,6 +215,7 @@ def load_motion(
     calibration=None,
     floor: float | None = None,
     threads: int = 2,
+    seed: int = 0,
 ):
     """Joints of INPUT: keypoints + fit for a video, a reader for motion files.
 
@@ -210,13 +230,19 @@ def load_motion(
     floor : float, optional
         The floor's height, metres (see :func:`capture`); the joints are
         moved so that it is z = 0.
+    seed : int
+        Seed of the camera estimate's bootstrap.
 
     Returns
     -------
     motion : FitResult
     track : KeypointTrack or None
+    estimate : CameraEstimate or None
+        The camera estimated from the person (keypoints and video only; None
+        when the feet are never seen or for motion files).  Without
+        `calibration` the fit's camera takes its roll.
     seconds : dict
-        Time spent in ``keypoints`` and ``fitting`` (or ``read``).
+        Time spent in ``keypoints``, ``camera`` and ``fitting`` (or ``read``).
     """
     seconds = {}
     if kind in FITTED_KINDS:
@@ -246,11 +272,19 @@ def load_motion(
             camera = Camera.from_calibration(known, path, track.image_size, undistorted=True)
             log.info("capture: using the camera of %s", calibration)
         t0 = time.perf_counter()
-        motion = fit_track(pinhole, camera=camera)
+        estimate = _estimate_camera(track, seed)
+        seconds["camera"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        roll = (
+            0.0
+            if estimate is None or camera is not None
+            else float(np.clip(estimate.roll_deg, -MAX_ROLL_DEG, MAX_ROLL_DEG))
+        )
+        motion = fit_track(pinhole, camera=camera, roll_deg=roll)
         if floor is not None:
             motion = _lowered(motion, floor)
         seconds["fitting"] = time.perf_counter() - t0
-        return motion, track, seconds
+        return motion, track, estimate, seconds
     if calibration is not None:
         raise PipelineError(f"--calibration {calibration}: a camera is for video input, not a {kind} file")
     from capture2notation.fitting.motion import read_motion
@@ -260,7 +294,7 @@ def load_motion(
     seconds["read"] = time.perf_counter() - t0
     if fps_override is not None:
         motion = _with_fps(motion, fps_override)
-    return motion, None, seconds
+    return motion, None, None, seconds
 
 
 def _lowered(motion, floor: float):
@@ -411,21 +445,12 @@ def capture(
     _check_options(backend, tempo, fps_override)
     kind = input_kind(input_path)
     outdir = Path(outdir)
-    motion, track, seconds = load_motion(
+    motion, track, estimate, seconds = load_motion(
         input_path, kind, backend, fps_override, progress, flip_test, calibration=calibration, floor=floor,
-        threads=threads,
+        threads=threads, seed=seed,
     )  # fmt: skip
-    estimate, camera_source = None, ""
+    camera_source = ""
     if track is not None:
-        from capture2notation.fitting.camera_estimate import estimate_camera
-
-        t0 = time.perf_counter()
-        try:
-            estimate = estimate_camera(track.xy, track.visibility, track.world, track.image_size, seed=seed)
-        except (C2NError, ValueError, np.linalg.LinAlgError) as exc:
-            # The estimate is a report beside the fit: say so and go on.
-            log.warning("capture: camera not estimated: %s", exc)
-        seconds["camera"] = time.perf_counter() - t0
         camera_source = "estimated" if calibration is None else f"calibration {calibration}"
         log.info("capture: %s", estimate.line() if estimate is not None else "camera not estimated (feet unseen)")
     return notate(

@@ -80,8 +80,9 @@ class Camera:
         hfov_deg: float = DEFAULT_HFOV_DEG,
         distance: float = DEFAULT_DISTANCE,
         height: float = DEFAULT_HEIGHT,
+        roll_deg: float = 0.0,
     ) -> Camera:
-        """Upright, level camera on +y looking at the origin (DESIGN.md's front view).
+        """Level camera on +y looking at the origin (DESIGN.md's front view).
 
         Parameters
         ----------
@@ -91,14 +92,23 @@ class Camera:
             Horizontal field of view, degrees, in (1, 179).
         distance, height : float
             Camera position ``(0, distance, height)`` in metres.
+        roll_deg : float
+            Turn about the optical axis, degrees, positive clockwise seen from
+            behind the camera (the convention of
+            :func:`~capture2notation.fitting.camera_estimate.pitch_roll`), in
+            [-45, 45]; 0 is upright.
         """
         if not 1.0 < hfov_deg < 179.0:
             raise FittingError(f"hfov_deg must be in (1, 179) degrees, got {hfov_deg}")
+        if not -45.0 <= roll_deg <= 45.0:
+            raise FittingError(f"roll_deg must be in [-45, 45] degrees, got {roll_deg}")
         w, h = (int(v) for v in image_size)
         f = 0.5 * w / np.tan(np.deg2rad(hfov_deg) / 2)
         K = np.array([[f, 0.0, w / 2], [0.0, f, h / 2], [0.0, 0.0, 1.0]])
         # Camera x = world -x, camera y (down) = world -z, camera z = world -y.
         R = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, -1.0, 0.0]])
+        c, s = np.cos(np.radians(roll_deg)), np.sin(np.radians(roll_deg))
+        R = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]) @ R
         centre = np.array([0.0, distance, height])
         return cls(K, R, -R @ centre, (w, h))
 

@@ -266,6 +266,7 @@ def fit_keypoints(
     times=None,
     image_size=None,
     options: FitOptions | None = None,
+    roll_deg: float = 0.0,
 ) -> FitResult:
     """Fit 3D joint angles to a track of 2D BlazePose landmarks.
 
@@ -292,6 +293,11 @@ def fit_keypoints(
     image_size : (width, height), optional
         Needed when `camera` is None.
     options : FitOptions, optional
+    roll_deg : float
+        Without `camera`: the default camera's roll about its optical axis,
+        degrees (:meth:`Camera.default`; e.g. from
+        :func:`~.camera_estimate.estimate_camera`, which reads it from the
+        trunk's image direction to about a degree).
 
     Returns
     -------
@@ -305,7 +311,8 @@ def fit_keypoints(
     if camera is None:
         if image_size is None:
             raise FittingError("fit_keypoints needs a camera or the image_size (width, height) for a default camera")
-        camera = refine_focal(xy, conf, fps, Camera.default(image_size), world=world, body=body, options=opt)
+        start = Camera.default(image_size, roll_deg=roll_deg)
+        camera = refine_focal(xy, conf, fps, start, world=world, body=body, options=opt)
     known = not set_floor
     # The camera and the figure's proportions belong to the whole clip; the
     # rest is fitted span by span (:mod:`.spans`: bounded memory).
@@ -518,7 +525,11 @@ def _problem(xy, conf, world, body: Body, camera: Camera, opt: FitOptions, floor
 
 
 def fit_track(
-    track, camera: Camera | None = None, body: Body | None = None, options: FitOptions | None = None
+    track,
+    camera: Camera | None = None,
+    body: Body | None = None,
+    options: FitOptions | None = None,
+    roll_deg: float = 0.0,
 ) -> FitResult:
     """Fit a :class:`~capture2notation.keypoints.KeypointTrack`.
 
@@ -529,7 +540,7 @@ def fit_track(
         ``world (T, 33, 3)`` (optional), ``fps``, ``times``, ``image_size``.
     camera : Camera, optional
         Known camera; default a :meth:`Camera.default` refined from the data.
-    body, options : optional
+    body, options, roll_deg : optional
         Passed to :func:`fit_keypoints`.  Without `options`, a BlazePose
         track has its world landmarks' rest offset removed
         (``DepthOptions(rest_offset=True)``).
@@ -558,6 +569,7 @@ def fit_track(
         times=getattr(track, "times", None),
         image_size=tuple(np.asarray(track.image_size).tolist()),
         options=options,
+        roll_deg=roll_deg,
     )
     ident = getattr(track, "identity_confidence", None)
     if ident is None or not np.any(np.isfinite(ident)):
