@@ -76,10 +76,11 @@ def round_trip(n: int, seed0: int = 20260000) -> None:
             forms[form] += 1
         if d:
             print(f"  seed {seed0 + i}: {len(d)} differences, e.g. {d[:2]}")
+    span = f" (amounts {min(amounts)}..{max(amounts)})" if amounts else ""
     print(
         f"truth round trip, {n} scores (turns, springs, travel, body key), tempo given: "
         f"{exact}/{n} exact, mean agreement {np.mean(agree):.3f}; "
-        f"turns written exactly {turns_ok}/{turns_all} (amounts {min(amounts)}..{max(amounts)}), "
+        f"turns written exactly {turns_ok}/{turns_all}{span}, "
         f"flights {flights_ok}/{flights_all}; spring forms drawn {dict(forms)}; {time.perf_counter() - t0:.0f} s"
     )
 

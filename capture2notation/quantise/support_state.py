@@ -278,6 +278,7 @@ def step_direction(
     height: float,
     offset: np.ndarray | None = None,
     starts: dict | None = None,
+    bearing: tuple[bool, bool] | None = None,
 ) -> str:
     """``place``, or the direction a weight-bearing foot stepped between frames a and k.
 
@@ -285,7 +286,12 @@ def step_direction(
     measurement (:func:`standing_foot_offset`), removed first.  `starts`
     (foot index → frame; measured motion): where each foot's travel is
     measured from instead of `a` (the last frame it bore weight), and a
-    foot steps only if :func:`plausible_step`.
+    foot steps only if :func:`plausible_step`.  `bearing` (right, left):
+    the feet of the support before, when known; default: the feet
+    ``labels`` find supporting at `a`.  A foot resting on the floor outside
+    that support (the front foot left behind by a step back) takes the
+    weight as a step when it lies a step from the closing place: the body
+    travels there (DESIGN.md: a step moves the body a step length).
     """
     feet = {0: (0, 1), 1: (0,), 2: (1,)}[part]
     best, best_d = None, STEP_MIN_FRACTION * height
@@ -295,14 +301,15 @@ def step_direction(
         af = a if starts is None else starts.get(f, a)
         foot = joints[k, joint_index(f"{side}_ankle")]
         moved = np.linalg.norm((foot - joints[af, joint_index(f"{side}_ankle")])[:2])
-        if moved < 0.05 and labels.supporting[af, f]:
+        bore = labels.supporting[af] if bearing is None else np.asarray(bearing, bool)
+        if moved < 0.05 and bore[f]:
             # A foot that bore weight where it stands did not step.  One
             # that was off the floor (left behind by the other foot's step)
             # may land a step away from the weight where it lifted.
             continue
         if starts is not None and not plausible_step(joints, f, af, k, height):
             continue
-        if not labels.supporting[af, f] and labels.supporting[af, 1 - f]:
+        if not bore[f] and bore[1 - f]:
             # A free foot comes down relative to the foot bearing the weight.
             rel = foot - closing_place(joints, af, f)
         else:

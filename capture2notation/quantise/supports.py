@@ -112,7 +112,8 @@ def support_movements(
             k += 1
         if part[k] < 0:
             continue
-        direction = step_direction(joints, labels, a, k, part[k], height)
+        bearing = (state[0] in (0, 1), state[0] in (0, 2))  # the feet of the support before
+        direction = step_direction(joints, labels, a, k, part[k], height, bearing=bearing)
         new = (int(part[k]), int(level[k]), direction)
         if new == state:
             continue

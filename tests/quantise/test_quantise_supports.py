@@ -143,6 +143,14 @@ SUPPORT_CASES = {
     ],
     "plie_releve_middle": ["0 2 support place low", "2 2 support place high", "4 2 support place middle"],
     "releve_on_one_foot": ["0 2 right_support place high", "2 1 left_leg left low", "3 2 support place middle"],
+    # A step back, then the weight forward onto the front foot, which never
+    # moved: the body travels a step forward (DESIGN.md), so it is a step.
+    "step_back_then_forward_onto_the_front_foot": [
+        "0 3/2 support place high",
+        "3/2 1 left_support back middle",
+        "5/2 3/4 right_support forward middle",
+        "13/4 3/2 right_support place high",
+    ],
     "side_steps_then_plie": [
         "1 1/2 right_support right middle",
         "3/2 1 support place middle",
