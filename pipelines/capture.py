@@ -191,6 +191,20 @@ def _with_fps(motion, fps: float):
 #: the trunk's image direction, so a larger one is more likely a dancer's
 #: lasting side lean than the camera.
 MAX_ROLL_DEG = 20.0
+#: The roll estimate's own noise, degrees: a dancer's leans across the image
+#: read as roll (level cameras, random scores and held-out phrases, front,
+#: 45° and side: median error 0.8°, 90 % within 2.4°).  Only the roll beyond
+#: it is taken (soft threshold): a level camera's fit is not turned by
+#: its dancer's leans, a rolled one's mostly is.
+ROLL_NOISE_DEG = 2.0
+
+
+def _fit_roll(estimate) -> float:
+    """The roll the unknown camera's fit takes from `estimate` (degrees; 0 without one)."""
+    if estimate is None:
+        return 0.0
+    r = float(estimate.roll_deg)
+    return float(np.sign(r) * np.clip(abs(r) - ROLL_NOISE_DEG, 0.0, MAX_ROLL_DEG))
 
 
 def _estimate_camera(track, seed: int):
@@ -275,11 +289,7 @@ def load_motion(
         estimate = _estimate_camera(track, seed)
         seconds["camera"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        roll = (
-            0.0
-            if estimate is None or camera is not None
-            else float(np.clip(estimate.roll_deg, -MAX_ROLL_DEG, MAX_ROLL_DEG))
-        )
+        roll = 0.0 if camera is not None else _fit_roll(estimate)
         motion = fit_track(pinhole, camera=camera, roll_deg=roll)
         if floor is not None:
             motion = _lowered(motion, floor)

@@ -310,7 +310,7 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
     feet = P[:, list(_FOOT)]
     feet_seen = seen[frames][:, list(_FOOT)]
     hips = 0.5 * (P[:, 23] + P[:, 24])
-    trunk = np.concatenate([0.5 * (P[:, 11] + P[:, 12]) - hips, hips - 0.5 * (P[:, 27] + P[:, 28])])
+    trunk = 0.5 * (P[:, 11] + P[:, 12]) - hips
     trunk /= np.linalg.norm(trunk, axis=-1, keepdims=True)
     sigma_axis = np.radians(AXIS_SIGMA_DEG)
 

@@ -583,3 +583,17 @@ def test_fitted_captures_take_the_fitted_capture_prior_for_effort(tmp_path, monk
     with pytest.raises(RuntimeError, match="stop here"):
         command.run_effort(folder, workers=1, plots=False)
     assert seen["sampler_kw"] == {"rho_range": CAPTURE_RHO_RANGE}
+
+
+@pytest.mark.parametrize(
+    ("estimated", "taken"), [(None, 0.0), (1.5, 0.0), (-2.0, 0.0), (6.0, 4.0), (-7.5, -5.5), (40.0, 20.0)]
+)
+def test_the_fit_takes_the_estimated_roll_beyond_its_noise(estimated, taken):
+    """The unknown camera's roll: the estimate less its noise (a dancer's leans), never beyond MAX_ROLL_DEG."""
+    from types import SimpleNamespace
+
+    from pipelines.capture import MAX_ROLL_DEG, ROLL_NOISE_DEG, _fit_roll
+
+    assert (ROLL_NOISE_DEG, MAX_ROLL_DEG) == (2.0, 20.0)  # the cases below are written for these
+    estimate = None if estimated is None else SimpleNamespace(roll_deg=estimated)
+    assert _fit_roll(estimate) == pytest.approx(taken)
