@@ -18,6 +18,18 @@ _ZERO_SPEED = 1e-6
 #: Split ratio of a noisy speed minimum where the part is near a written pose
 #: (see :func:`movement_spans`).
 NEAR_POSE_SPLIT_RATIO = 0.6
+#: Clean motion: a grid frame on a written pose ends a movement only where
+#: the speed slows (a local minimum) or kinks near it.  Two movements meet
+#: where one progress curve ends and the next starts, so the speed's slope
+#: jumps within a frame or two of the grid frame: the largest second
+#: difference of the speed there (frames f - 1 to f + 2), over the speed
+#: nearby, was at least 0.13 at each of the 86 such meetings without a
+#: minimum in 450 random scores (with turns, springs, random Effort), while
+#: a limb sweeping through a written pose on a grid frame passes it with a
+#: smooth speed (at most 0.014 at the 5 such frames).
+MIN_SPEED_KINK = 0.04
+#: Frames about a grid frame (before, after) where a meeting's kink may lie.
+_KINK_WINDOW = (1, 2)
 
 
 def movement_spans(
@@ -96,10 +108,12 @@ def movement_spans(
 def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> list[tuple[int, int]]:
     """Split [a, b] where the motion passes a written pose.
 
-    With a beat grid every grid frame accepted by ``key_pose`` is a boundary
-    (those for which ``key_pose.needs_minimum(f)``, if given, is true only
-    next to a local speed minimum: poses a movement may pass through
-    mid-way); without, only such frames next to a local speed minimum (a
+    With a beat grid every grid frame accepted by ``key_pose`` where the
+    speed slows or kinks (:data:`MIN_SPEED_KINK`) is a boundary (those for
+    which ``key_pose.needs_minimum(f)``, if given, is true only next to a
+    local speed minimum: poses a movement may pass through mid-way; those
+    for which ``key_pose.forced(f)`` is true always); without a grid, only
+    such frames next to a local speed minimum (a
     minimum in interval m puts the boundary at frame m, the next movement's
     first interval, or m + 1, this movement's last).
     """
@@ -110,9 +124,21 @@ def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> 
         # A local speed minimum in the interval just before or after f.
         return any(0 < m < s.size - 1 and s[m] <= s[m - 1] and s[m] <= s[m + 1] for m in (f - 1, f))
 
+    def kinks(f: int) -> bool:
+        # The speed's slope jumps near f (see MIN_SPEED_KINK).
+        for g in range(max(2, f - _KINK_WINDOW[0]), min(s.size - 1, f + _KINK_WINDOW[1] + 1)):
+            d2 = (s[g] - s[g - 1]) - 0.5 * ((s[g - 1] - s[g - 2]) + (s[g + 1] - s[g]))
+            scale = float(np.max(s[g - 2 : g + 2]))
+            if not scale > 0 or abs(d2) >= MIN_SPEED_KINK * scale:
+                return True
+        return f < 2 or f + 1 >= s.size  # at the signal's ends it cannot be told
+
+    forced = getattr(key_pose, "forced", lambda f: False)
     if key_pose.on_grid:
         for f in range(a + 1, b + 1):
-            if key_pose(f, cuts[-1] if cuts else a) and (needs_minimum is None or not needs_minimum(f) or slows(f)):
+            if not key_pose(f, cuts[-1] if cuts else a):
+                continue
+            if forced(f) or (slows(f) if needs_minimum is not None and needs_minimum(f) else slows(f) or kinks(f)):
                 cuts.append(f)
     else:
         for m in range(a + 1, b):

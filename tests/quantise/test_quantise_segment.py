@@ -138,6 +138,33 @@ def test_movement_spans_on_clean_motion_cut_at_written_poses():
     assert 8 in calls
 
 
+def test_a_written_pose_passed_on_a_grid_frame_ends_a_movement_only_where_the_speed_kinks():
+    """Clean motion: two progress curves meet with a jump in the speed's slope; one curve sweeps on smoothly."""
+    from capture2notation.notation.effort import progress
+
+    def curve(frames, degrees):
+        """Speed (degrees per second at 25 fps) over each interval of one movement's progress curve."""
+        return np.diff(progress(np.linspace(0.0, 1.0, frames + 1), -3.0, 0.45)) * degrees * 25.0
+
+    one = curve(30, 180.0)  # one sweep of 180° over 30 frames
+    two = np.r_[curve(15, 135.0), curve(15, 45.0)]  # 135° then 45°, back to back
+    pad = np.zeros(3)
+
+    def key_at(frame):
+        def key(f, since):
+            return f == frame
+
+        key.on_grid = True
+        return key
+
+    # The sweep passes a written pose at frame 3 + 15 without a kink: one movement.
+    smooth = np.r_[pad, one, pad]
+    assert movement_spans(smooth, low=1e-4, high=2e-4, split_ratio=0.35, key_pose=key_at(18)) == [(3, 32)]
+    # A movement ends at frame 18 and the next starts there from rest: two.
+    met = np.r_[pad, two, pad]
+    assert movement_spans(met, low=1e-4, high=2e-4, split_ratio=0.35, key_pose=key_at(18)) == [(3, 17), (18, 32)]
+
+
 def test_too_short_or_bad_input():
     with pytest.raises(QuantiseError, match="at least 2 frames"):
         segment(np.zeros((1, 21, 3)), 25.0, tempo=60)
