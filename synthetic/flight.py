@@ -63,6 +63,22 @@ def _smooth(tau):
     return tau * tau * (3.0 - 2.0 * tau)
 
 
+def _pitch_clear(ankle_z: np.ndarray, toe: np.ndarray) -> np.ndarray:
+    """(n,) the most pointed foot pitch (radians, negative points) keeping the toe clear of the floor.
+
+    The toe at `toe` (3,) from the ankle in the foot's frame, the foot only
+    pitched (``rot_x``): its height is ``ankle_z + R sin(p + φ)``; the toe
+    stays :data:`~synthetic.supports.LIFT_OFF_CLEARANCE` above the floor.
+    Where no pitch can (the ankle itself too low), −π/2 (no limit).
+    """
+    from .supports import LIFT_OFF_CLEARANCE
+
+    ty, tz = float(toe[1]), float(toe[2])
+    radius, phi = np.hypot(ty, tz), np.arctan2(tz, ty)
+    need = (LIFT_OFF_CLEARANCE - np.asarray(ankle_z, float)) / radius
+    return np.where(np.abs(need) <= 1.0, np.arcsin(np.clip(need, -1.0, 1.0)) - phi, -np.pi / 2)
+
+
 def plan_flight(sup, air, landings, before, xy: dict, level: dict) -> None:
     """Plan frames (frame(a), frame(b)] of flight `air` on the :class:`~synthetic.supports.Support` `sup`.
 
@@ -151,6 +167,14 @@ def plan_flight(sup, air, landings, before, xy: dict, level: dict) -> None:
                 ankle[n] = root[n] + (1.0 - w)[:, None] * off_a + w[:, None] * off_b
                 base = (1.0 - w) * pitch[fa] + w * pb
                 pitch[n] = base + (point - base) * np.sin(np.pi * tau) ** 2
+                # A low flight has no room for a fully pointed foot: the toe
+                # would brush the floor at the top and the dancer would be
+                # seen landing mid-air.  It points only as far as keeps it
+                # clear, like a gesturing foot's.
+                air_frames = n < fb
+                pitch[n[air_frames]] = np.maximum(
+                    pitch[n[air_frames]], _pitch_clear(ankle[n[air_frames], 2], sup.toe_offset)
+                )
                 sup.floor[foot][n] = True
             else:
                 # Down from a gesture (the landing blend of leg_tracks).

@@ -189,3 +189,16 @@ def test_thirty_random_scores_cover_turns_springs_travel_and_keys():
     assert counts["directions"] == {"right", "left"}
     assert min(counts["amounts"]) == Fraction(1, 8) and max(counts["amounts"]) >= Fraction(3, 2)
     assert counts["steps"] >= 30 and counts["axes"] == {"standard", "body"}
+
+
+@pytest.mark.parametrize("seed", [20300008, 20320023])
+def test_a_low_flight_keeps_both_feet_off_the_floor(seed):
+    """Under 0.35 s in the air the pelvis rises about 12 cm: a fully pointed foot would brush the floor."""
+    score = random_score(np.random.default_rng(seed), n_beats=8, turns=True, springs=True, travel=True, axes="body")
+    J = interpret(score, fps=FPS).joints()
+    feet = _feet(J)
+    flights = [s for s in score.symbols if s.is_air]
+    assert flights and any(float(s.duration) * 60 / float(score.tempo) < 0.35 for s in flights)
+    for s in flights:
+        fa, fb = _frame(s.start, score), _frame(s.end, score)
+        assert min(feet[f][0][fa + 1 : fb].min() for f in feet) > SUPPORT_HEIGHT
