@@ -63,19 +63,16 @@ def _smooth(tau):
     return tau * tau * (3.0 - 2.0 * tau)
 
 
-def _pitch_clear(ankle_z: np.ndarray, toe: np.ndarray) -> np.ndarray:
-    """(n,) the most pointed foot pitch (radians, negative points) keeping the toe clear of the floor.
+def _pitch_clear(ankle_z: np.ndarray, toe: np.ndarray, clearance: float) -> np.ndarray:
+    """(n,) the most pointed foot pitch (radians, negative points) keeping the toe `clearance` up.
 
     The toe at `toe` (3,) from the ankle in the foot's frame, the foot only
-    pitched (``rot_x``): its height is ``ankle_z + R sin(p + φ)``; the toe
-    stays :data:`~synthetic.supports.LIFT_OFF_CLEARANCE` above the floor.
-    Where no pitch can (the ankle itself too low), −π/2 (no limit).
+    pitched (``rot_x``): its height is ``ankle_z + R sin(p + φ)``.  Where no
+    pitch can keep it there (the ankle itself too low), −π/2 (no limit).
     """
-    from .supports import LIFT_OFF_CLEARANCE
-
     ty, tz = float(toe[1]), float(toe[2])
     radius, phi = np.hypot(ty, tz), np.arctan2(tz, ty)
-    need = (LIFT_OFF_CLEARANCE - np.asarray(ankle_z, float)) / radius
+    need = (clearance - np.asarray(ankle_z, float)) / radius
     return np.where(np.abs(need) <= 1.0, np.arcsin(np.clip(need, -1.0, 1.0)) - phi, -np.pi / 2)
 
 
@@ -170,10 +167,10 @@ def plan_flight(sup, air, landings, before, xy: dict, level: dict) -> None:
                 # A low flight has no room for a fully pointed foot: the toe
                 # would brush the floor at the top and the dancer would be
                 # seen landing mid-air.  It points only as far as keeps it
-                # clear, like a gesturing foot's.
+                # clear, like a gesturing foot's (Support.toe_clearance).
                 air_frames = n < fb
                 pitch[n[air_frames]] = np.maximum(
-                    pitch[n[air_frames]], _pitch_clear(ankle[n[air_frames], 2], sup.toe_offset)
+                    pitch[n[air_frames]], _pitch_clear(ankle[n[air_frames], 2], sup.toe_offset, sup.toe_clearance)
                 )
                 sup.floor[foot][n] = True
             else:

@@ -167,6 +167,7 @@ class Support:
         self.toe0 = body.rest[joint_index("right_toe")][2]
         toe = body.offsets[joint_index("right_toe")]
         self.toe_offset = toe  # the toe from the ankle, in the foot's frame (both feet alike)
+        self.toe_clearance = LIFT_OFF_CLEARANCE  # least toe height of a foot off the floor: gesturing or in the air
         pitch = -np.radians(RELEVE_DEG)
         self.rise = toe[2] - (rot_x(pitch) @ toe)[2]
         self.level_z = {"low": self.ankle0, "middle": self.ankle0, "high": self.ankle0 + self.rise}
