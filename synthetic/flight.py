@@ -168,9 +168,9 @@ def plan_flight(sup, air, landings, before, xy: dict, level: dict) -> None:
                 # would brush the floor at the top and the dancer would be
                 # seen landing mid-air.  It points only as far as keeps it
                 # clear, like a gesturing foot's (Support.toe_clearance).
-                air_frames = n < fb
-                pitch[n[air_frames]] = np.maximum(
-                    pitch[n[air_frames]], _pitch_clear(ankle[n[air_frames], 2], sup.toe_offset, sup.toe_clearance)
+                aloft = n[:-1]  # every frame but the touchdown's
+                pitch[aloft] = np.maximum(
+                    pitch[aloft], _pitch_clear(ankle[aloft, 2], sup.toe_offset, sup.toe_clearance)
                 )
                 sup.floor[foot][n] = True
             else:

@@ -322,7 +322,7 @@ def _key_pose_fn(
         return change >= min_change
 
     key.on_grid = on_grid is not None
-    key.needs_minimum = lambda f: bool(pair_only[f] and not forced[f])
+    key.needs_minimum = lambda f: bool(pair_only[f])
     key.forced = lambda f: bool(forced[f])
     return key
 

@@ -134,11 +134,17 @@ def _split_at_key_poses(s: np.ndarray, a: int, b: int, low: float, key_pose) -> 
         return f < 2 or f + 1 >= s.size  # at the signal's ends it cannot be told
 
     forced = getattr(key_pose, "forced", lambda f: False)
+
+    def ends_here(f: int) -> bool:
+        if forced(f):
+            return True
+        if needs_minimum is not None and needs_minimum(f):
+            return slows(f)
+        return slows(f) or kinks(f)
+
     if key_pose.on_grid:
         for f in range(a + 1, b + 1):
-            if not key_pose(f, cuts[-1] if cuts else a):
-                continue
-            if forced(f) or (slows(f) if needs_minimum is not None and needs_minimum(f) else slows(f) or kinks(f)):
+            if key_pose(f, cuts[-1] if cuts else a) and ends_here(f):
                 cuts.append(f)
     else:
         for m in range(a + 1, b):
