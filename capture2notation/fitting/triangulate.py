@@ -2,7 +2,11 @@
 
 Per landmark and frame, a confidence-weighted direct linear transform (DLT,
 Hartley & Zisserman §12.2) on undistorted, normalised image coordinates;
-each view's two rows are scaled by its keypoint visibility.  A view whose
+each view's two rows are scaled by its keypoint visibility, however low: a
+keypoint model's visibility is not a reliability (BlazePose rates arm
+landmarks in front of the body 0.05-0.3 that lie within a few pixels of the
+truth), and a low-weight view still fixes the depth along the other view's
+ray, while the two rays' residual judges the point.  A view whose
 reprojection error exceeds :data:`OUTLIER_PX` is dropped when at least three
 views see the point (a hidden or mirrored limb in one view), the worst one
 first; with two views the reprojection residual lowers the point's
@@ -23,7 +27,6 @@ from ..body.skeleton import BLAZEPOSE_TO_JOINT
 from ..errors import FittingError
 
 __all__ = [
-    "MIN_VISIBILITY",
     "OUTLIER_PX",
     "RESIDUAL_PX",
     "SIDE_GROUPS",
@@ -33,9 +36,6 @@ __all__ = [
     "triangulate",
 ]
 
-#: Visibility below which a view does not vote for a point: BlazePose's
-#: visibility of a limb hidden behind the body is mostly under 0.3.
-MIN_VISIBILITY = 0.3
 #: Reprojection error, pixels, above which one of three or more views is an
 #: outlier: BlazePose's keypoint noise on a 640x480 dancer is a few pixels,
 #: a mirrored or hidden limb tens of pixels.
@@ -86,7 +86,7 @@ def triangulate(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     uv : (V, T, N, 2) ndarray
         Pixels per view, frame and point; NaN where unseen.
     visibility : (V, T, N) ndarray
-        In [0, 1]; the DLT weight of each view (below :data:`MIN_VISIBILITY`: no vote).
+        In [0, 1]; the DLT weight of each view (0: no vote).
     cameras : sequence of V CameraCalibration
         ``capture2notation.io.calibration`` cameras (K, dist, R, t).
 
@@ -114,7 +114,6 @@ def triangulate(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     xn = np.stack([_normalised(uv[v], cameras[v]).reshape(M, 2) for v in range(V)])
     P = np.stack([np.hstack([c.R, np.asarray(c.t).reshape(3, 1)]) for c in cameras])
     w = np.where(np.all(np.isfinite(xn), axis=-1), np.clip(np.nan_to_num(vis.reshape(V, M)), 0, 1), 0.0)
-    w = np.where(w >= MIN_VISIBILITY, w, 0.0)
     X = _dlt(xn, w, P)
     err = _reprojection(X, uv.reshape(V, M, 2), cameras, w > 0)
     # Drop the worst view of a point while it is an outlier and two views remain.

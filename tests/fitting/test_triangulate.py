@@ -72,6 +72,22 @@ def test_two_views_weight_by_visibility_and_lower_confidence_by_residual():
     assert np.all(conf[:, 7] < 0.5 * np.median(conf[:, good]))
 
 
+def test_a_view_of_low_visibility_still_votes_with_that_weight():
+    # A keypoint model's visibility is a weight, not a gate: a point one view
+    # rates 0.1 but places right is triangulated, on the better view's ray.
+    rng = np.random.default_rng(7)
+    cams = _cameras([0, 90])
+    X = rng.uniform([-0.8, -0.8, 0.0], [0.8, 0.8, 1.8], (10, 33, 3))
+    uv = _views(cams, X, rng)
+    vis = np.ones(uv.shape[:3])
+    vis[1, :, 3] = 0.1
+    P, conf, used = triangulate(uv, vis, cams)
+    assert np.all(used[:, :, 3])
+    assert np.percentile(np.linalg.norm(P[:, 3] - X[:, 3], axis=-1), 99) < _tolerance(cams, 2)
+    # Its confidence is the views' mean weight: lower than a point both see well.
+    assert np.all(conf[:, 3] < 0.6) and np.all(conf[:, 3] > 0.0)
+
+
 def test_one_camera_is_refused():
     cams = _cameras([0])
     with pytest.raises(FittingError, match="two cameras"):
