@@ -140,8 +140,27 @@ def _align(tracks, offsets_s, videos, fps: float):
 MONO_WEIGHT = 0.3
 
 
-def _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor: float = 0.0):
+def landmark_joints() -> np.ndarray:
+    """(J,) bool: the joints a landmark measures (and the pelvis, the hips' midpoint).
+
+    The trunk's inner joints and the head are never triangulated: the fit
+    places them from the shoulders, hips, nose and ears.  Filling them from
+    one view's fit would pull the spine to that fit's guess (with exact
+    keypoints of random scores: the waist 5 cm off, the chest leaning 6°
+    forward on average).
+    """
+    from capture2notation.body import JOINTS
+    from capture2notation.body.skeleton import BLAZEPOSE_TO_JOINT
+
+    names = {"pelvis", *BLAZEPOSE_TO_JOINT.values()}
+    return np.array([name in names for name in JOINTS])
+
+
+def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor: float = 0.0):
     """Joints no two views saw, from the monocular fit of the view that sees them best.
+
+    `missing` (T, J) marks them (only joints a landmark measures:
+    :func:`landmark_joints`).
 
     Returns
     -------
@@ -160,7 +179,6 @@ def _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor: fl
     from capture2notation.fitting.camera import undistort_track
     from capture2notation.io.calibration import read_calibration
 
-    missing = jconf == 0
     seen = []
     for t, s in zip(tracks, spans):
         vis = np.zeros(missing.shape)
@@ -301,10 +319,10 @@ def load_views(
         raise PipelineError(f"{videos[0]}: {exc}") from None
     joints[..., 2] -= floor
     virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
-    missing = jconf == 0
+    missing = (jconf == 0) & landmark_joints()[None, :]
     if missing.any():
         t1 = time.perf_counter()
-        joints, jconf = _monocular_fill(joints, jconf, tracks, spans, videos, calibration, floor)
+        joints, jconf = _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor)
         seconds["monocular"] = time.perf_counter() - t1
     seconds["triangulate"] = time.perf_counter() - t0
     t0 = time.perf_counter()
