@@ -624,10 +624,12 @@ def _pelvis_window(pelvis: np.ndarray, lo: int, a: int, b: int, hi: int, fps: fl
     progress from its mean over [lo, a] to its mean over [b, hi] (the state
     changes between frames a and b); None when it moves less than
     :data:`MIN_PELVIS_M` or the window is too short."""
-    if hi - lo < 4:
+    before, after = pelvis[lo : a + 1], pelvis[b : hi + 1]
+    # An empty or unmeasured half window has no mean to measure from.
+    if hi - lo < 4 or not (np.isfinite(before).all(axis=1).any() and np.isfinite(after).all(axis=1).any()):
         return None
-    p0 = np.nanmean(pelvis[lo : a + 1], axis=0)
-    p1 = np.nanmean(pelvis[b : hi + 1], axis=0)
+    p0 = np.nanmean(before, axis=0)
+    p1 = np.nanmean(after, axis=0)
     d = p1 - p0
     n2 = float(d @ d)
     if not n2 > MIN_PELVIS_M**2:

@@ -381,3 +381,20 @@ def test_a_squat_sitting_back_behind_both_feet_stands_on_both():
     assert np.asarray(out.supporting).all()
     # Its level is the standing foot's (low here, a plié).
     assert (np.asarray(out.support_level) == 0).all()
+
+
+def test_a_pelvis_window_without_frames_on_one_side_is_no_window():
+    # The state's change may come after the window's end (b > hi) or over
+    # frames the capture lost: no progress can be measured, and no warning.
+    import warnings
+
+    from capture2notation.quantise.supports_measured import _pelvis_window
+
+    pelvis = np.column_stack([np.linspace(0.0, 0.5, 20), np.zeros(20), np.full(20, 0.9)])
+    lost = pelvis.copy()
+    lost[12:] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert _pelvis_window(pelvis, 0, 5, 15, 12, 25.0) is None
+        assert _pelvis_window(lost, 0, 5, 12, 19, 25.0) is None
+        assert _pelvis_window(pelvis, 0, 5, 12, 19, 25.0) is not None
