@@ -57,12 +57,17 @@ def test_three_views_with_an_outlier_view_recover_the_points():
     assert OUTLIER_PX < 60.0  # the test's mirrored limb is an outlier by the named threshold
 
 
-def test_two_views_weight_by_visibility_and_lower_confidence_by_residual():
-    rng = np.random.default_rng(4)
+def _two_views(seed: int):
+    """Front and side cameras, 10 frames of 33 random points, their pixels and full visibility."""
+    rng = np.random.default_rng(seed)
     cams = _cameras([0, 90])
     X = rng.uniform([-0.8, -0.8, 0.0], [0.8, 0.8, 1.8], (10, 33, 3))
     uv = _views(cams, X, rng)
-    vis = np.ones(uv.shape[:3])
+    return cams, X, uv, np.ones(uv.shape[:3])
+
+
+def test_two_views_weight_by_visibility_and_lower_confidence_by_residual():
+    cams, X, uv, vis = _two_views(4)
     vis[1, :, 5] = 0.0  # one view does not see point 5: no triangulation
     uv[0, :, 7] += 40.0  # a point off in one of two views
     P, conf, _ = triangulate(uv, vis, cams)
@@ -75,11 +80,7 @@ def test_two_views_weight_by_visibility_and_lower_confidence_by_residual():
 def test_a_view_of_low_visibility_still_votes_with_that_weight():
     # A keypoint model's visibility is a weight, not a gate: a point one view
     # rates 0.1 but places right is triangulated, on the better view's ray.
-    rng = np.random.default_rng(7)
-    cams = _cameras([0, 90])
-    X = rng.uniform([-0.8, -0.8, 0.0], [0.8, 0.8, 1.8], (10, 33, 3))
-    uv = _views(cams, X, rng)
-    vis = np.ones(uv.shape[:3])
+    cams, X, uv, vis = _two_views(7)
     vis[1, :, 3] = 0.1
     P, conf, used = triangulate(uv, vis, cams)
     assert np.all(used[:, :, 3])
