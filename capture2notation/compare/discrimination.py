@@ -215,8 +215,10 @@ class SameDifferentObserver:
             raise CompareError(f"calibration needs >= 4 performances as (N, F) features, got {x.shape}")
         if len(set(e.tolist())) < 2:
             raise CompareError("calibration needs performances of at least two emotions")
-        with np.errstate(invalid="ignore"):
-            scale = np.nanstd(x, axis=0)
+        # A feature no training performance measured keeps unit scale.
+        measured = np.isfinite(x).any(axis=0)
+        scale = np.ones(x.shape[1])
+        scale[measured] = np.nanstd(x[:, measured], axis=0)
         scale = np.where(np.isfinite(scale) & (scale > 1e-9), scale, 1.0)
         i, j = np.triu_indices(len(x), k=1)
         obs = cls(scale, 0.0)

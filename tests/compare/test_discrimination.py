@@ -106,3 +106,16 @@ def test_missing_features_and_pool_errors():
         run_trials(experiment1_trials(complexities=("easy",)), {}, obs, np.random.default_rng(0))
     with pytest.raises(CompareError, match="at least two emotions"):
         SameDifferentObserver.calibrate(np.zeros((4, 4)), ["sad"] * 4)
+
+
+def test_a_feature_no_performance_measured_keeps_unit_scale_without_a_warning():
+    import warnings
+
+    rng = np.random.default_rng(3)
+    x, e = performances(rng, 3, noise=0.3)
+    x = np.array(x, float)
+    x[:, 1] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        obs = SameDifferentObserver.calibrate(x, e)
+    assert obs.scale[1] == 1.0 and np.all(np.isfinite(obs.scale))
