@@ -140,27 +140,11 @@ def _align(tracks, offsets_s, videos, fps: float):
 MONO_WEIGHT = 0.3
 
 
-def landmark_joints() -> np.ndarray:
-    """(J,) bool: the joints a landmark measures (and the pelvis, the hips' midpoint).
-
-    The trunk's inner joints and the head are never triangulated: the fit
-    places them from the shoulders, hips, nose and ears.  Filling them from
-    one view's fit would pull the spine to that fit's guess (with exact
-    keypoints of random scores: the waist 5 cm off, the chest leaning 6°
-    forward on average).
-    """
-    from capture2notation.body import JOINTS
-    from capture2notation.body.skeleton import BLAZEPOSE_TO_JOINT
-
-    names = {"pelvis", *BLAZEPOSE_TO_JOINT.values()}
-    return np.array([name in names for name in JOINTS])
-
-
 def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor: float = 0.0):
     """Joints no two views saw, from the monocular fit of the view that sees them best.
 
     `missing` (T, J) marks them (only joints a landmark measures:
-    :func:`landmark_joints`).
+    :data:`~capture2notation.fitting.triangulate.MEASURED_JOINTS`).
 
     Returns
     -------
@@ -275,7 +259,13 @@ def load_views(
     """
     from capture2notation.fitting.fit3d import fit_points3d
     from capture2notation.fitting.motion import floor_height
-    from capture2notation.fitting.triangulate import find_offset, landmarks_to_joints, match_sides, triangulate
+    from capture2notation.fitting.triangulate import (
+        MEASURED_JOINTS,
+        find_offset,
+        landmarks_to_joints,
+        match_sides,
+        triangulate,
+    )
     from capture2notation.io.calibration import camera_name
 
     videos = [Path(v) for v in videos]
@@ -319,7 +309,11 @@ def load_views(
         raise PipelineError(f"{videos[0]}: {exc}") from None
     joints[..., 2] -= floor
     virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
-    missing = (jconf == 0) & landmark_joints()[None, :]
+    # Only joints a landmark measures can be missing: filling the spine and
+    # head from one view's fit would pull them to that fit's guess (with
+    # exact keypoints of random scores: the waist 5 cm off, the chest
+    # leaning 6° forward on average).
+    missing = (jconf == 0) & MEASURED_JOINTS[None, :]
     if missing.any():
         t1 = time.perf_counter()
         joints, jconf = _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor)

@@ -27,6 +27,7 @@ from ..body.skeleton import BLAZEPOSE_TO_JOINT
 from ..errors import FittingError
 
 __all__ = [
+    "MEASURED_JOINTS",
     "OUTLIER_PX",
     "RESIDUAL_PX",
     "SIDE_GROUPS",
@@ -255,6 +256,13 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
             vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
             swapped[v, :, g] = frames
     return uv, vis, swapped
+
+
+#: (J,) bool: the joints :func:`landmarks_to_joints` measures, those a
+#: landmark is and the pelvis (the hips' midpoint).  The trunk's inner joints
+#: and the head never are: the fit places them from the shoulders, hips,
+#: nose and ears.
+MEASURED_JOINTS = np.array([name == "pelvis" or name in BLAZEPOSE_TO_JOINT.values() for name in JOINTS])
 
 
 def landmarks_to_joints(points, confidence) -> tuple[np.ndarray, np.ndarray, dict]:

@@ -73,29 +73,20 @@ def test_two_view_marker_capture_writes_every_output(two_views, tmp_path):
 def test_the_spine_is_placed_by_the_fit_not_by_one_views_guess(two_views, tmp_path, monkeypatch):
     """Exact keypoints from both views: every landmark joint is triangulated, and the
     waist and chest, which no landmark measures, come out where the dancer's are
-    (one view's monocular fit of them had put the waist 2 cm off here, 5 cm on
+    (one view's monocular fit of them had put the waist 7 cm off here, 5 cm on
     random scores)."""
+    from dataclasses import replace
+
     import pipelines.capture_multi as cm
     from capture2notation.body import joint_index
-    from capture2notation.keypoints import KeypointTrack
+    from synthetic.identity_errors import truth_track
 
     _, root = two_views
 
     def exact_tracks(videos, *args, **kwargs):
-        out = []
-        for v in videos:
-            t = read_truth(v.parent / "truth.npz")
-            kp = np.asarray(t.keypoints, float)
-            T = len(kp)
-            out.append(
-                KeypointTrack(
-                    fps=float(t.fps), times=np.arange(T) / float(t.fps), image_size=np.array([320, 240]),
-                    xy=np.concatenate([kp, np.zeros((T, 33, 1))], axis=2), visibility=np.ones((T, 33)),
-                    presence=np.ones(T), world=np.full((T, 33, 3), np.nan), crops=np.full((T, 5), np.nan),
-                    backend="blazepose",
-                )
-            )  # fmt: skip
-        return out
+        # Exact pixels, but no world landmarks: one view's fit must guess depth.
+        tracks = [truth_track(dict(np.load(v.parent / "truth.npz"))) for v in videos]
+        return [replace(t, world=np.full_like(t.world, np.nan), backend="blazepose") for t in tracks]
 
     monkeypatch.setattr(cm, "_keypoints", exact_tracks)
     res = capture(
