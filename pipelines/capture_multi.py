@@ -257,14 +257,17 @@ def load_views(
     source : str
         The cameras used, for the page.
     """
+    from capture2notation.fitting import Camera
     from capture2notation.fitting.fit3d import fit_points3d
     from capture2notation.fitting.motion import floor_height
     from capture2notation.fitting.triangulate import (
+        LANDMARK_TARGETS,
         MEASURED_JOINTS,
         find_offset,
         landmarks_to_joints,
         match_sides,
         triangulate,
+        undistorted_pixels,
     )
     from capture2notation.io.calibration import camera_name
 
@@ -324,7 +327,20 @@ def load_views(
     # The floor is now z = 0: the fit holds the lowest foot there, as the
     # one-view fit does through a known camera (triangulated feet jitter by
     # centimetres, about the quantiser's 3-cm support threshold).
-    motion = fit_points3d(joints, jconf, fps, times=times - times[0], virtual=virtual, floor=True)
+    # The cameras' own keypoints judge the triangulated points: a limb one
+    # view sees well keeps to that view (fit3d's module docstring).
+    targets = np.array([i for i, _ in LANDMARK_TARGETS])
+    names_t = [n for _, n in LANDMARK_TARGETS]
+    views = [
+        (
+            Camera(np.asarray(c.K), np.asarray(c.R), np.asarray(c.t) + floor * np.asarray(c.R)[:, 2], c.image_size),
+            undistorted_pixels(uv[v][:, targets], c),
+            vis[v][:, targets],
+            names_t,
+        )
+        for v, c in enumerate(cameras)
+    ]
+    motion = fit_points3d(joints, jconf, fps, times=times - times[0], virtual=virtual, floor=True, views=views)
     seconds["fitting"] = time.perf_counter() - t0
     names = [camera_name(v) for v in videos]
 

@@ -1,8 +1,17 @@
-"""Fit the body model to measured 3D joint positions (BVH mocap, Kinect skeletons).
+"""Fit the body model to measured 3D joint positions (BVH mocap, Kinect skeletons, triangulated keypoints).
 
 Data terms: joint positions ``‖p_i(θ_t) − X_i‖ / σ_3d`` and the directions of
 the measured segments (so differences between the source's and our segment
 lengths do not bend the fit), solved by :func:`~capture2notation.fitting.solver.solve`.
+
+Points triangulated from calibrated cameras can be refined against the
+cameras' own keypoints (``views``): the model's segment lengths and joint
+limits then judge the views.  Two views of a hidden or mislabelled limb give
+a point between the right ray and the wrong one, with no majority to vote
+the wrong one out; fitted to the images, a limb of fixed length whose
+projection one view measures well keeps to that view, and each keypoint's
+weight falls with its distance from the fitted pose (Cauchy's noise model,
+scale :data:`VIEW_SCALE_PX`).
 """
 
 from __future__ import annotations
@@ -15,11 +24,48 @@ from .ik import initial_angles
 from .lengths import estimate_offsets
 from .model import PoseModel
 from .result import FitResult
-from .solver import FOOT_POINTS, FitOptions, Terms, check_fps, fill2, floor_terms, rewarm, solve, to_result
+from .solver import (
+    FOOT_POINTS,
+    FitOptions,
+    Terms,
+    ViewTerms,
+    check_fps,
+    fill2,
+    floor_terms,
+    rewarm,
+    solve,
+    to_result,
+)
 
-__all__ = ["fit_points3d"]
+__all__ = ["VIEW_3D_WEIGHT", "VIEW_ROUNDS", "VIEW_SCALE_PX", "fit_points3d"]
 
 _J = len(JOINTS)
+
+#: Scale of the Cauchy weight ``1 / (1 + (e / VIEW_SCALE_PX)²)`` of a view's
+#: keypoint at reprojection error ``e`` from the fitted pose, pixels:
+#: BlazePose's keypoint noise on a 640×480 dancer is a few pixels, a hidden
+#: limb's guess or a mirrored label tens.
+VIEW_SCALE_PX = 15.0
+#: Reweighting rounds of the fit to the views (iteratively reweighted least
+#: squares: each round's weights come from the previous round's pose).
+VIEW_ROUNDS = 3
+#: Iterations of the solver per round.
+VIEW_ITERATIONS = 6
+#: Weight of the triangulated points and their directions while fitting to
+#: the views, relative to before: they keep the pose where no view is
+#: trusted, but carry the disagreement of the views they came from.
+VIEW_3D_WEIGHT = 0.1
+
+
+def _view_weights(model: PoseModel, params: np.ndarray, views) -> tuple[ViewTerms, ...]:
+    """Each view's targets weighted by visibility × Cauchy weight of the current reprojection error."""
+    pts = model.forward(params)
+    out = []
+    for cam, idx, uv, vis in views:
+        e = np.linalg.norm(cam.project(pts[:, idx]) - uv, axis=-1)
+        w = vis / (1.0 + (e / VIEW_SCALE_PX) ** 2)
+        out.append(ViewTerms(cam, idx, uv, np.where(np.isfinite(w), w, 0.0)))
+    return tuple(out)
 
 
 def fit_points3d(
@@ -31,6 +77,7 @@ def fit_points3d(
     virtual: dict[str, np.ndarray] | None = None,
     options: FitOptions | None = None,
     floor: bool = False,
+    views=None,
 ) -> FitResult:
     """Fit joint angles to measured 3D joint positions (mocap, Kinect).
 
@@ -55,6 +102,11 @@ def fit_points3d(
         height with :attr:`FitOptions.sigma_floor` (Huber: jumps go), as the
         one-view fit's is through a known camera.  Triangulated feet scatter
         by centimetres; a support is judged against the floor by less.
+    views : sequence of (Camera, (T, N, 2) ndarray, (T, N) ndarray, sequence of str), optional
+        The cameras the points were triangulated from, with their keypoints
+        (pixels, lens distortion removed; NaN where unseen), visibilities in
+        [0, 1] and the model point each keypoint measures (a joint or a
+        virtual point): the fit is refined against them (module docstring).
 
     Returns
     -------
@@ -107,6 +159,8 @@ def fit_points3d(
     params0[:, 3:] = ang[:, model.dof_joint, model.dof_axis]
     params, cost = solve(model, params0, terms, fps, opt, opt.iterations)
     params, cost = rewarm(model, params, cost, terms, fps, opt)
+    if views:
+        params = _fit_views(model, params, terms, views, fps, opt)
     usable = np.sum(conf >= opt.min_confidence, axis=1) >= min(opt.min_targets, 4)
     err = np.linalg.norm(model.forward(params)[:, :_J] - points, axis=-1) / opt.sigma_3d
     quality = 1.0 / (1.0 + (np.nan_to_num(err, nan=np.inf) / 3.0) ** 2)
@@ -116,3 +170,27 @@ def fit_points3d(
     for j in np.nonzero(missing)[0]:
         jc[:, j] = jc[:, body.parents[j]] * 0.5 if body.parents[j] >= 0 else 0.0
     return to_result(model, params, fps, times, jc, usable)
+
+
+def _fit_views(model: PoseModel, params, terms: Terms, views, fps: float, opt: FitOptions) -> np.ndarray:
+    """`params` refined against the views' keypoints (module docstring)."""
+    T = params.shape[0]
+    prepared = []
+    for v, (cam, uv, vis, names) in enumerate(views):
+        uv = np.asarray(uv, float)
+        vis = np.asarray(vis, float)
+        if uv.shape != (T, len(names), 2) or vis.shape != uv.shape[:2]:
+            raise FittingError(
+                f"view {v}: keypoints must be (T={T}, {len(names)}, 2) with visibility (T, {len(names)}); "
+                f"got {uv.shape}, {vis.shape}"
+            )
+        idx = np.array([model.index(n) for n in names])
+        seen = np.all(np.isfinite(uv), axis=-1)
+        prepared.append((cam, idx, np.where(seen[..., None], uv, np.nan), np.where(seen, np.clip(vis, 0, 1), 0.0)))
+    terms.w3 = terms.w3 * VIEW_3D_WEIGHT
+    if terms.wd is not None:
+        terms.wd = terms.wd * VIEW_3D_WEIGHT
+    for _ in range(VIEW_ROUNDS):
+        terms.views = _view_weights(model, params, prepared)
+        params, _ = solve(model, params, terms, fps, opt, VIEW_ITERATIONS, frozen=np.zeros(0, int))
+    return params

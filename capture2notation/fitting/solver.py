@@ -31,7 +31,7 @@ from .model import PoseModel
 from .result import FitResult
 from .spans import CONTEXT_S, SPAN_S
 
-__all__ = ["FitOptions", "Terms", "rewarm", "solve", "to_result"]
+__all__ = ["FitOptions", "Terms", "ViewTerms", "rewarm", "solve", "to_result"]
 
 _J = len(JOINTS)
 
@@ -163,6 +163,27 @@ class FitOptions:
     depth: DepthOptions | None = field(default_factory=DepthOptions)
 
 
+@dataclass(frozen=True)
+class ViewTerms:
+    """Image targets in one more calibrated camera (multi-camera fits).
+
+    Attributes
+    ----------
+    camera : Camera
+    idx2 : (N,) ndarray of int
+        Model point of each target.
+    obs2 : (T, N, 2) ndarray
+        Pixels (lens distortion removed); NaN where unseen.
+    w2 : (T, N) ndarray
+        Weights in [0, 1]; 0 where unseen.
+    """
+
+    camera: Camera
+    idx2: np.ndarray
+    obs2: np.ndarray
+    w2: np.ndarray
+
+
 @dataclass
 class Terms:
     """Observations of one fit, already mapped to model points."""
@@ -180,6 +201,7 @@ class Terms:
     floor_idx: np.ndarray | None = None  # (F,) point index of the feet's lowest points
     floor_z: np.ndarray | None = None  # (F,) their heights above the floor in a flat-footed stance, metres
     floor_w: np.ndarray | None = None  # (T,)
+    views: tuple[ViewTerms, ...] = ()  # image targets in further cameras
 
 
 #: Model points that can touch the floor.
@@ -232,27 +254,28 @@ def _normal_equations(model: PoseModel, params, terms: Terms, opt: FitOptions, n
             rows_r.append((sw * r).reshape(T, -1))
             rows_J.append((sw[..., None] * Jr).reshape(T, -1, n))
 
-    if terms.idx2 is not None:
-        cam = terms.camera
-        p = pts[:, terms.idx2]
-        c = cam.to_camera(p)
+    def reprojection(cam: Camera, idx, obs2, w2):
+        c = cam.to_camera(pts[:, idx])
         z = np.maximum(c[..., 2], 1e-3)
         f = np.array([cam.K[0, 0], cam.K[1, 1]])
         uv = c[..., :2] / z[..., None] * f + cam.K[:2, 2]
         depth = np.maximum(cam.to_camera(params[:, :3])[:, 2], 0.1)
         s = depth / (cam.focal * opt.sigma_2d)  # (T,) pixels -> sigma units
-        obs = np.nan_to_num(terms.obs2)
-        r = (uv - obs) * s[:, None, None]
+        r = (uv - np.nan_to_num(obs2)) * s[:, None, None]
         Jr = None
         if need_jac:
             # d(uv)/dp = f/z (R_row - c_row/z R_2), then chain with dp/dθ.
-            R = cam.R
-            dcam = R @ jac[:, terms.idx2]  # (T, N, 3, n)
+            dcam = cam.R @ jac[:, idx]  # (T, N, 3, n)
             duv = (dcam[:, :, :2] - (c[..., :2] / z[..., None])[..., None] * dcam[:, :, 2:3]) * (
                 f[None, None, :, None] / z[..., None, None]
             )
             Jr = duv * s[:, None, None, None]
-        add(r, terms.w2, Jr)
+        add(r, w2, Jr)
+
+    if terms.idx2 is not None:
+        reprojection(terms.camera, terms.idx2, terms.obs2, terms.w2)
+    for view in terms.views:
+        reprojection(view.camera, view.idx2, view.obs2, view.w2)
 
     if terms.pairs is not None:
         a, b = terms.pairs[:, 0], terms.pairs[:, 1]
@@ -427,6 +450,7 @@ def _subset(terms: Terms, sl: slice) -> Terms:
         v = getattr(terms, k)
         if v is not None:
             setattr(out, k, v[sl])
+    out.views = tuple(ViewTerms(v.camera, v.idx2, v.obs2[sl], v.w2[sl]) for v in terms.views)
     return out
 
 

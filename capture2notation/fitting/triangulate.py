@@ -27,6 +27,7 @@ from ..body.skeleton import BLAZEPOSE_TO_JOINT
 from ..errors import FittingError
 
 __all__ = [
+    "LANDMARK_TARGETS",
     "MEASURED_JOINTS",
     "OUTLIER_PX",
     "RESIDUAL_PX",
@@ -35,6 +36,7 @@ __all__ = [
     "landmarks_to_joints",
     "match_sides",
     "triangulate",
+    "undistorted_pixels",
 ]
 
 #: Reprojection error, pixels, above which one of three or more views is an
@@ -59,6 +61,19 @@ def _normalised(uv: np.ndarray, cam) -> np.ndarray:
         pts = cv2.undistortPoints(flat[ok].reshape(-1, 1, 2).astype(np.float64), cam.K, cam.dist)
         out[ok] = pts.reshape(-1, 2)
     return out.reshape(uv.shape)
+
+
+def undistorted_pixels(uv: np.ndarray, cam) -> np.ndarray:
+    """Pixels ``(..., 2)`` as `cam`'s pinhole part would see them (lens distortion removed; NaN kept)."""
+    K = np.asarray(cam.K, float)
+    return _normalised(uv, cam) * np.array([K[0, 0], K[1, 1]]) + K[:2, 2]
+
+
+#: ``(BlazePose landmark index, model point name)`` of every landmark the fit
+#: takes: our joints' and the virtual points'.
+LANDMARK_TARGETS: tuple[tuple[int, str], ...] = tuple(
+    sorted({**BLAZEPOSE_TO_JOINT, **{i: n for n, i in _VIRTUAL.items()}}.items())
+)
 
 
 def _dlt(xn: np.ndarray, w: np.ndarray, P: np.ndarray) -> np.ndarray:

@@ -55,6 +55,50 @@ def test_perfect_keypoints_of_two_views_fit_within_the_target(two_views):
     assert float(np.nanmean(err)) < MPJPE_TARGET_M
 
 
+@pytest.mark.parametrize("chunk", [None, 24])
+def test_a_view_that_misplaces_an_arm_is_outvoted_by_the_bones_and_the_other_view(two_views, chunk, monkeypatch):
+    """The side view puts the left arm 12 px too low for a stretch (a hidden arm's
+    guess; at 320×240 about 6 cm).  Triangulated, the two rays meet nowhere and
+    the fit to the points lands between them; fitted to the views' keypoints,
+    the arm of fixed length keeps to the front view, which sees it right.
+    `chunk`: the solver's batches as a long clip's (each view's targets cut alike)."""
+    import importlib
+
+    from capture2notation.body import joint_index
+
+    if chunk:
+        monkeypatch.setattr(importlib.import_module("capture2notation.fitting.solver"), "CHUNK", chunk)
+    from capture2notation.fitting import Camera
+    from capture2notation.fitting.triangulate import LANDMARK_TARGETS
+
+    _, root = two_views
+    cal = read_calibration(root / "cameras.toml")
+    cams = [cal[v] for v in VIEWS]
+    truths = [read_truth(root / v / "truth.npz") for v in VIEWS]
+    uv = np.stack([np.asarray(t.keypoints, float) for t in truths])
+    vis = np.ones(uv.shape[:3])
+    T = uv.shape[1]
+    bad = slice(T // 4, T // 2)
+    uv[1, bad, [13, 15, 17, 19, 21], 1] += 12.0  # left elbow, wrist and hand points, downwards
+    points, conf, _ = triangulate(uv, vis, cams)
+    joints, jconf, virtual = landmarks_to_joints(points, conf)
+    lm = np.array([i for i, _ in LANDMARK_TARGETS])
+    names = [n for _, n in LANDMARK_TARGETS]
+    views = [
+        (Camera(np.asarray(c.K), np.asarray(c.R), np.asarray(c.t), c.image_size), uv[v][:, lm], vis[v][:, lm], names)
+        for v, c in enumerate(cams)
+    ]
+    truth = np.asarray(truths[0].joints)[bad, joint_index("left_wrist")]
+
+    def wrist_error(fit):
+        return float(np.median(np.linalg.norm(np.asarray(fit.joints)[bad, joint_index("left_wrist")] - truth, axis=-1)))
+
+    points_only = wrist_error(fit_points3d(joints, jconf, truths[0].fps, virtual=virtual))
+    with_views = wrist_error(fit_points3d(joints, jconf, truths[0].fps, virtual=virtual, views=views))
+    assert points_only > MPJPE_TARGET_M  # the injected error matters
+    assert with_views < 0.5 * points_only and with_views < MPJPE_TARGET_M
+
+
 def test_two_view_marker_capture_writes_every_output(two_views, tmp_path):
     _, root = two_views
     res = capture(
