@@ -219,6 +219,36 @@ def _swap_frames(keep: np.ndarray, swap: np.ndarray) -> np.ndarray:
     return median_filter(swap - keep, size=SIDE_MEDIAN_FRAMES, mode="nearest") < 0
 
 
+#: Difference of two labellings' mean reprojection errors, pixels, under
+#: which reprojection does not decide between them: a few pixels of keypoint
+#: noise.  Two cameras placed symmetrically about a dancer facing between
+#: them see her swapped labels triangulate almost as well, turned by 90°.
+SIDE_AMBIGUOUS_PX = 6.0
+
+
+#: Angle, degrees, seen from above, by which two labellings must turn the
+#: shoulders apart for the head to decide between them: a side view sees
+#: both shoulders at one place, and its labellings differ by little.
+SIDE_APART_DEG = 60.0
+
+
+def _forward(left_to_right: np.ndarray) -> np.ndarray:
+    """Horizontal forward (T, 3) of a body whose left → right vector is given (up × that vector)."""
+    out = np.zeros_like(left_to_right)
+    out[:, 0], out[:, 1] = -left_to_right[:, 1], left_to_right[:, 0]
+    return out
+
+
+def _head_forward(uv, vis, cameras) -> np.ndarray:
+    """The nose's offset (T, 3) from the ears' midpoint, triangulated from two views.
+
+    Unchanged by swapping the ears' labels in either view: the nose has
+    none, and the two ear points keep their midpoint.
+    """
+    P, _, _ = triangulate(uv[:, :, [0, 7, 8]], vis[:, :, [0, 7, 8]], cameras)
+    return P[:, 0] - 0.5 * (P[:, 1] + P[:, 2])
+
+
 def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Relabel left and right in each view to agree with the first view, per frame and limb group.
 
@@ -226,11 +256,17 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     (or arms) as a whole; triangulating a swapped view against a right one
     puts both limbs between them.  For each view after the first, each
     group of :data:`SIDE_GROUPS` and each frame, the labelling whose
-    two-view triangulation with the first view reprojects closer is kept;
-    for the legs, only among labellings whose hips (the group's first pair)
-    turn with the shoulders (the arms' first pair, decided first) within
-    :data:`MAX_TWIST_DEG` seen from above: two cameras placed symmetrically
-    about a front-facing dancer cannot tell swapped legs by reprojection.
+    two-view triangulation with the first view reprojects closer is kept.
+    Two cameras placed symmetrically about a front-facing dancer cannot tell
+    swapped limbs by reprojection (the swapped rays meet too, the body
+    turned by 90°), so two priors decide where it cannot: for the arms,
+    where the labellings reproject within :data:`SIDE_AMBIGUOUS_PX` of each
+    other and turn the shoulders at least :data:`SIDE_APART_DEG` apart, the
+    one whose shoulders face where the head looks (the nose ahead of the
+    ears' midpoint, which no relabelling moves); for the legs, only
+    labellings whose hips (the group's first pair) turn with the shoulders
+    (the arms' first pair, decided first) within :data:`MAX_TWIST_DEG` seen
+    from above.
 
     Parameters
     ----------
@@ -260,6 +296,16 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
                 np.stack([uv[0][:, idx], uv[v][:, alt]]), np.stack([vis[0][:, idx], vis[v][:, alt]]), pair
             )
             if g == 0:
+                # Where reprojection cannot tell, the shoulders face where the head does.
+                tie = np.abs(swap - keep) < SIDE_AMBIGUOUS_PX
+                head = _head_forward(uv[[0, v]], vis[[0, v]], pair)
+                c_keep = _horizontal_cos(_forward(v_keep), head)
+                c_swap = _horizontal_cos(_forward(v_swap), head)
+                # ... and only where the two labellings turn the shoulders apart.
+                apart = _horizontal_cos(v_keep, v_swap) < np.cos(np.radians(SIDE_APART_DEG))
+                decided = tie & apart & np.isfinite(c_keep) & np.isfinite(c_swap)
+                keep = np.where(decided, 1.0 - c_keep, keep)
+                swap = np.where(decided, 1.0 - c_swap, swap)
                 shoulders = np.where(_swap_frames(keep, swap)[:, None], v_swap, v_keep)
             else:
                 # The hips turn with the shoulders (the arms group, decided first).
