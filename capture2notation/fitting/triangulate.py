@@ -239,14 +239,22 @@ def _forward(left_to_right: np.ndarray) -> np.ndarray:
     return out
 
 
-def _head_forward(uv, vis, cameras) -> np.ndarray:
-    """The nose's offset (T, 3) from the ears' midpoint, triangulated from two views.
+#: Least horizontal offset of the nose from the ears' midpoint, metres, for
+#: the head to overrule the keypoint model's own labels: about 9 cm when
+#: upright, less as the head tilts up or down.
+HEAD_MIN_M = 0.04
+
+
+def _head_forward(uv, vis, cameras, min_m: float = 0.0) -> np.ndarray:
+    """The nose's offset (T, 3) from the ears' midpoint, triangulated (NaN under `min_m` seen from above).
 
     Unchanged by swapping the ears' labels in either view: the nose has
     none, and the two ear points keep their midpoint.
     """
     P, _, _ = triangulate(uv[:, :, [0, 7, 8]], vis[:, :, [0, 7, 8]], cameras)
-    return P[:, 0] - 0.5 * (P[:, 1] + P[:, 2])
+    h = P[:, 0] - 0.5 * (P[:, 1] + P[:, 2])
+    # A head tilted far up or down says little about where it faces.
+    return np.where(np.linalg.norm(h[:, :2], axis=1, keepdims=True) >= min_m, h, np.nan)
 
 
 def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -266,7 +274,8 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     ears' midpoint, which no relabelling moves); for the legs, only
     labellings whose hips (the group's first pair) turn with the shoulders
     (the arms' first pair, decided first) within :data:`MAX_TWIST_DEG` seen
-    from above.
+    from above.  Last, where the keypoint model mirrored the first view
+    too, every view is relabelled (:func:`_unmirror`).
 
     Parameters
     ----------
@@ -278,7 +287,7 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     -------
     uv, visibility : relabelled copies
     swapped : (V, T, G) ndarray of bool
-        Where a view's group was relabelled (the first view never is).
+        Where a view's group was relabelled.
     """
     uv = np.array(uv, float)
     vis = np.array(visibility, float)
@@ -316,6 +325,42 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
             uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
             vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
             swapped[v, :, g] = frames
+    if V >= 2:
+        uv, vis, swapped = _unmirror(uv, vis, cameras, swapped)
+    return uv, vis, swapped
+
+
+#: Cosine of the angle, seen from above, between the shoulders' forward and
+#: the head's under which (the head turned more than 135° from the
+#: shoulders, far past a neck's reach of about 80°) the body is mirrored.
+MIRRORED_COS = -0.7
+
+
+def _unmirror(uv, vis, cameras, swapped):
+    """Swap left and right in every view where the triangulated body is mirrored.
+
+    Matching makes the views agree with the first view, so where the keypoint
+    model mirrored the first view (a back view read as a front view) every
+    view is mirrored alike, and the rays meet on a mirror image.  Its
+    shoulders then face away from where the head looks (the nose ahead of
+    the ears' midpoint, which no relabelling moves); its hips turn with its
+    shoulders, so both groups are swapped, in every view.
+    """
+    arms = np.array([i for ab in SIDE_GROUPS["arms"][:1] for i in ab])
+    P, _, _ = triangulate(uv[:, :, arms], vis[:, :, arms], cameras)
+    cos = _horizontal_cos(_forward(P[:, 1] - P[:, 0]), _head_forward(uv, vis, cameras, HEAD_MIN_M))
+    score = np.where(np.isfinite(cos), cos - MIRRORED_COS, 0.0)
+    frames = median_filter(score, size=SIDE_MEDIAN_FRAMES, mode="nearest") < 0
+    if not frames.any():
+        return uv, vis, swapped
+    uv, vis, swapped = uv.copy(), vis.copy(), swapped.copy()
+    for g, pairs in enumerate(SIDE_GROUPS.values()):
+        idx = np.array([i for ab in pairs for i in ab])
+        alt = np.array([i for a, b in pairs for i in (b, a)])
+        for v in range(uv.shape[0]):
+            uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
+            vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
+            swapped[v, frames, g] = ~swapped[v, frames, g]
     return uv, vis, swapped
 
 

@@ -8,6 +8,7 @@ import pytest
 from capture2notation.errors import FittingError
 from capture2notation.fitting.triangulate import (
     MAX_TWIST_DEG,
+    MIRRORED_COS,
     OUTLIER_PX,
     SIDE_AMBIGUOUS_PX,
     SIDE_APART_DEG,
@@ -194,3 +195,26 @@ def test_symmetric_cameras_keep_the_arms_the_head_faces_with():
     _uv2, _vis2, swapped = match_sides(uv, vis, cams)
     assert not swapped[:, :, 0].any()
     assert SIDE_AMBIGUOUS_PX > 2 * NOISE_PX and SIDE_APART_DEG < 90.0  # the tie and the 90° turn are within the limits
+
+
+def test_a_body_mirrored_in_every_view_is_turned_back_by_its_head():
+    """The keypoint model mirrors every view alike (a back view read as a front
+    view): the rays meet on a mirror image whose shoulders face away from
+    where the head looks (:data:`MIRRORED_COS`), and every view is relabelled."""
+    rng = np.random.default_rng(13)
+    cams = _cameras([0, 90])
+    X = _symmetric_stance(30, rng)
+    X[:, 7] = X[:, 0] + (-0.07, -0.09, 0.02)  # left ear
+    X[:, 8] = X[:, 0] + (0.07, -0.09, 0.02)  # right ear
+    uv = _views(cams, X, rng)
+    mirrored = np.arange(33)
+    for a in range(11, 33, 2):
+        mirrored[[a, a + 1]] = a + 1, a
+    mirrored[[7, 8]] = 8, 7
+    uv = uv[:, :, mirrored]
+    vis = np.ones(uv.shape[:3])
+    uv2, _vis2, swapped = match_sides(uv, vis, cams)
+    assert swapped.all()
+    P, _conf, _used = triangulate(uv2, vis, cams)
+    assert np.all(P[:, 16, 1] > 0.4) and np.all(P[:, 16, 0] > 0.1)  # the raised right wrist, ahead on the right
+    assert np.cos(np.radians(90.0)) > MIRRORED_COS  # a head turned by a neck's reach is not a mirror
