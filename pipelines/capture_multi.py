@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from capture2notation.errors import C2NError, PipelineError
+from capture2notation.errors import PipelineError
 
 __all__ = ["MAX_AUTO_LAG_S", "check_views", "load_views", "parse_offsets"]
 
@@ -257,18 +257,9 @@ def load_views(
     source : str
         The cameras used, for the page.
     """
-    from capture2notation.fitting import Camera
-    from capture2notation.fitting.fit3d import fit_points3d
-    from capture2notation.fitting.motion import floor_height
-    from capture2notation.fitting.triangulate import (
-        LANDMARK_TARGETS,
-        MEASURED_JOINTS,
-        find_offset,
-        landmarks_to_joints,
-        match_sides,
-        triangulate,
-        undistorted_pixels,
-    )
+    from capture2notation.errors import FittingError
+    from capture2notation.fitting.multiview import fit_views
+    from capture2notation.fitting.triangulate import find_offset
     from capture2notation.io.calibration import camera_name
 
     videos = [Path(v) for v in videos]
@@ -296,52 +287,19 @@ def load_views(
     vis = np.stack(
         [t.visibility[s] * np.clip(np.nan_to_num(t.presence[s]), 0, 1)[:, None] for t, s in zip(tracks, spans)]
     )
-    uv, vis, swapped = match_sides(uv, vis, cameras)
-    if swapped.any():
-        log.info("capture: left/right relabelled in %.0f %% of view-frames", 100 * swapped[1:].any(-1).mean())
-    points, conf, _used = triangulate(uv, vis, cameras)
-    joints, jconf, virtual = landmarks_to_joints(points, conf)
-    if not np.any(jconf > 0):
-        raise PipelineError(f"{videos[0]}: no joint was seen by two cameras at once (no person, or wrong calibration?)")
-    # DESIGN.md: the floor comes from where the triangulated feet rest (a
-    # monocular fill is too loose in depth to set it), not from the
-    # calibration's zero (BlazePose's foot points sit above the sole).
-    try:
-        floor = floor_height(joints, jconf)
-    except C2NError as exc:
-        raise PipelineError(f"{videos[0]}: {exc}") from None
-    joints[..., 2] -= floor
-    virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
-    # Only joints a landmark measures can be missing: filling the spine and
-    # head from one view's fit would pull them to that fit's guess (with
-    # exact keypoints of random scores: the waist 5 cm off, the chest
-    # leaning 6° forward on average).
-    missing = (jconf == 0) & MEASURED_JOINTS[None, :]
-    if missing.any():
+
+    def fill(joints, jconf, missing, floor):
         t1 = time.perf_counter()
-        joints, jconf = _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor)
+        out = _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor)
         seconds["monocular"] = time.perf_counter() - t1
-    seconds["triangulate"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
+        return out
+
     times = np.asarray(tracks[0].times)[spans[0]]
-    # The floor is now z = 0: the fit holds the lowest foot there, as the
-    # one-view fit does through a known camera (triangulated feet jitter by
-    # centimetres, about the quantiser's 3-cm support threshold).
-    # The cameras' own keypoints judge the triangulated points: a limb one
-    # view sees well keeps to that view (fit3d's module docstring).
-    targets = np.array([i for i, _ in LANDMARK_TARGETS])
-    names_t = [n for _, n in LANDMARK_TARGETS]
-    views = [
-        (
-            Camera(np.asarray(c.K), np.asarray(c.R), np.asarray(c.t) + floor * np.asarray(c.R)[:, 2], c.image_size),
-            undistorted_pixels(uv[v][:, targets], c),
-            vis[v][:, targets],
-            names_t,
-        )
-        for v, c in enumerate(cameras)
-    ]
-    motion = fit_points3d(joints, jconf, fps, times=times - times[0], virtual=virtual, floor=True, views=views)
-    seconds["fitting"] = time.perf_counter() - t0
+    try:
+        motion, _floor = fit_views(uv, vis, cameras, fps, times=times - times[0], fill=fill)
+    except FittingError as exc:
+        raise PipelineError(f"{videos[0]}: {exc}") from None
+    seconds["triangulate and fit"] = time.perf_counter() - t0 - seconds.get("monocular", 0.0)
     names = [camera_name(v) for v in videos]
 
     def per_view(stage: Path) -> dict:

@@ -1,0 +1,120 @@
+"""The body's motion from the keypoints of two or more calibrated cameras.
+
+Left and right made to agree across the views
+(:func:`~.triangulate.match_sides`), a visibility-weighted triangulation
+(:func:`~.triangulate.triangulate`), the floor from where the triangulated
+feet rest (:func:`~.motion.floor_height`), then :func:`~.fit3d.fit_points3d`
+to the triangulated joints, refined against every view's own keypoints.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+
+import numpy as np
+
+from ..errors import C2NError, FittingError
+from .camera import Camera
+from .fit3d import fit_points3d
+from .motion import floor_height
+from .result import FitResult
+from .triangulate import (
+    LANDMARK_TARGETS,
+    MEASURED_JOINTS,
+    landmarks_to_joints,
+    match_sides,
+    triangulate,
+    undistorted_pixels,
+)
+
+__all__ = ["fit_views"]
+
+log = logging.getLogger(__name__)
+
+
+def fit_views(
+    uv,
+    visibility,
+    cameras,
+    fps: float,
+    times=None,
+    fill: Callable | None = None,
+) -> tuple[FitResult, float]:
+    """Fit the body to 33 BlazePose landmarks seen by calibrated cameras.
+
+    Parameters
+    ----------
+    uv : (V, T, 33, 2) ndarray
+        Pixels per view (lens distortion included, as the camera saw them);
+        NaN where a view has no keypoint.
+    visibility : (V, T, 33) ndarray
+        In [0, 1]: each view's weight for each keypoint.
+    cameras : sequence of V CameraCalibration
+    fps : float
+    times : (T,) ndarray, optional
+        Seconds; default ``arange(T) / fps``.
+    fill : callable, optional
+        ``fill(joints, conf, missing, floor) -> (joints, conf)`` supplies the
+        landmark joints no two views saw (``missing``, (T, J) bool), in the
+        floor-shifted world, e.g. from one view's monocular fit; without it
+        they are left to the fit's skeleton (confidence 0).  The trunk and
+        head are never filled: a guess of them would pull the fit's spine.
+
+    Returns
+    -------
+    motion : FitResult
+        In the cameras' world with the floor moved to z = 0.
+    floor : float
+        The floor's height in the cameras' world, metres.
+
+    Raises
+    ------
+    FittingError
+        No joint seen by two cameras at once, or no floor in the data.
+    """
+    uv = np.asarray(uv, float)
+    vis = np.asarray(visibility, float)
+    uv, vis, swapped = match_sides(uv, vis, cameras)
+    if swapped.any():
+        log.info("capture: left/right relabelled in %.0f %% of view-frames", 100 * swapped.any(-1).mean())
+    points, conf, _used = triangulate(uv, vis, cameras)
+    joints, jconf, virtual = landmarks_to_joints(points, conf)
+    if not np.any(jconf > 0):
+        raise FittingError("no joint was seen by two cameras at once (no person, or wrong calibration?)")
+    # DESIGN.md: the floor comes from where the triangulated feet rest (a
+    # monocular fill is too loose in depth to set it), not from the
+    # calibration's zero (BlazePose's foot points sit above the sole).
+    try:
+        floor = floor_height(joints, jconf)
+    except C2NError as exc:
+        raise FittingError(str(exc)) from None
+    joints[..., 2] -= floor
+    virtual = {k: (p - np.array([0.0, 0.0, floor]), c) for k, (p, c) in virtual.items()}
+    # Only joints a landmark measures can be missing: filling the spine and
+    # head from one view's fit would pull them to that fit's guess (with
+    # exact keypoints of random scores: the waist 5 cm off, the chest
+    # leaning 6° forward on average).
+    missing = (jconf == 0) & MEASURED_JOINTS[None, :]
+    if fill is not None and missing.any():
+        joints, jconf = fill(joints, jconf, missing, floor)
+    T = uv.shape[1]
+    times = np.arange(T) / fps if times is None else np.asarray(times, float)
+    # The cameras' own keypoints judge the triangulated points: a limb one
+    # view sees well keeps to that view (fit3d's module docstring).
+    targets = np.array([i for i, _ in LANDMARK_TARGETS])
+    names = [n for _, n in LANDMARK_TARGETS]
+    views = [
+        (
+            Camera(np.asarray(c.K), np.asarray(c.R), np.asarray(c.t) + floor * np.asarray(c.R)[:, 2], c.image_size),
+            undistorted_pixels(uv[v][:, targets], c),
+            vis[v][:, targets],
+            names,
+        )
+        for v, c in enumerate(cameras)
+    ]
+    # The floor is now z = 0: the fit holds the lowest foot there, as the
+    # one-view fit does through a known camera (triangulated feet jitter by
+    # centimetres, about the quantiser's 3-cm support threshold).
+    motion = fit_points3d(joints, jconf, fps, times=times, virtual=virtual, floor=True, views=views)
+    return motion, float(floor)
