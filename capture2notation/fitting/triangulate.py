@@ -249,10 +249,15 @@ def _head_forward(uv, vis, cameras, min_m: float = 0.0) -> np.ndarray:
     """The nose's offset (T, 3) from the ears' midpoint, triangulated (NaN under `min_m` seen from above).
 
     Unchanged by swapping the ears' labels in either view: the nose has
-    none, and the two ear points keep their midpoint.
+    none, and the two ear points keep their midpoint.  Where the ears are
+    not both triangulated, from the shoulders' midpoint.
     """
-    P, _, _ = triangulate(uv[:, :, [0, 7, 8]], vis[:, :, [0, 7, 8]], cameras)
+    P, _, _ = triangulate(uv[:, :, [0, 7, 8, 11, 12]], vis[:, :, [0, 7, 8, 11, 12]], cameras)
     h = P[:, 0] - 0.5 * (P[:, 1] + P[:, 2])
+    # Each ear seen by one camera only (two cameras either side of the face,
+    # a pose model that leaves hidden points out): the shoulders' midpoint,
+    # which a relabelling moves little, stands in for the ears'.
+    h = np.where(np.isfinite(h), h, P[:, 0] - 0.5 * (P[:, 3] + P[:, 4]))
     # A head tilted far up or down says little about where it faces.
     return np.where(np.linalg.norm(h[:, :2], axis=1, keepdims=True) >= min_m, h, np.nan)
 

@@ -50,7 +50,8 @@ class Condition:
     ----------
     factor : str
         The factor this condition varies from the baseline (``baseline``,
-        ``frame_rate``, ``image_size``, ``view``, ``compression``, ``noise``).
+        ``frame_rate``, ``image_size``, ``view``, ``cameras``, ``compression``,
+        ``noise``).
     frame_rate : str
         Exact rate as a fraction string (``"25/3"``).
     resampling : str
@@ -58,6 +59,7 @@ class Condition:
         two coincide).
     width, height : int
     view : str
+        The camera's view, or several calibrated cameras' joined by ``+``.
     compression : int
         JPEG quality, 0 = none.
     noise : float
@@ -80,6 +82,11 @@ class Condition:
     def params(self) -> tuple:
         """Everything but the factor label: equal params = same recording."""
         return (self.frame_rate, self.resampling, self.width, self.height, self.view, self.compression, self.noise)
+
+    @property
+    def views(self) -> tuple[str, ...]:
+        """The views of the condition's cameras (one unless :attr:`view` joins several with ``+``)."""
+        return tuple(self.view.split("+"))
 
     @property
     def label(self) -> str:
@@ -166,6 +173,7 @@ def build_conditions(cfg: StudyConfig) -> list[Condition]:
     out += [make("frame_rate", rate=r, method=m) for r in cfg.frame_rates for m in cfg.resampling]
     out += [make("image_size", size=s) for s in cfg.image_sizes]
     out += [make("view", view=v) for v in cfg.views]
+    out += [make("cameras", view=v) for v in cfg.cameras]
     out += [make("compression", comp=q) for q in cfg.compression]
     out += [make("noise", noise=n) for n in cfg.noise]
     seen, unique = set(), []

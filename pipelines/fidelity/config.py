@@ -2,7 +2,8 @@
 
 The study varies one factor at a time around a baseline recording (the
 thesis varied size and frame rate in separate experiments too): frame rate
-× resampling method, image size, viewpoint, compression and pixel noise.
+× resampling method, image size, viewpoint, the number and placement of
+calibrated cameras, compression and pixel noise.
 Every factor level is applied to every performance (phrase × emotion ×
 take).  Example ``study.toml``::
 
@@ -16,6 +17,7 @@ take).  Example ``study.toml``::
     resampling = ["keyframe", "naive"]
     image_sizes = [[220, 175], [320, 240], [640, 480], [1280, 720]]
     views = ["front", "45", "side"]
+    cameras = ["front+side", "45+-45", "front+45+side"]   # calibrated cameras filming at once
     compression = [0, 60, 20]  # JPEG quality; 0 = none
     noise = [0, 2, 5]          # pixel noise sigma
     [baseline]
@@ -70,6 +72,14 @@ QUICK_AUTO_CAPTURE = ("keypoints",)
 CAPTURES = ("auto", "truth", "keypoints", "video", "keypoints-calibrated", "video-calibrated")
 RESAMPLING = ("keyframe", "naive")
 VIEWS = ("front", "45", "side")
+#: Views a camera of a several-camera condition may take (the renderer's).
+CAMERA_VIEWS = ("front", "45", "side", "-45")
+
+
+def _is_cameras(x) -> bool:
+    """Two or more distinct views of :data:`CAMERA_VIEWS` joined by ``+``."""
+    parts = x.split("+") if isinstance(x, str) else []
+    return len(parts) >= 2 and len(set(parts)) == len(parts) and all(p in CAMERA_VIEWS for p in parts)
 
 
 @dataclass(frozen=True)
@@ -96,6 +106,10 @@ class StudyConfig:
     image_sizes : tuple of (int, int)
         (width, height) pixels.
     views : tuple of str
+    cameras : tuple of str
+        Several calibrated cameras filming at once, their views joined by
+        ``+`` (e.g. ``front+side``), triangulated (:mod:`pipelines.capture_multi`):
+        what a second or third camera buys over the baseline's one.
     compression : tuple of int
         JPEG quality 1–100; 0 = uncompressed.
     noise : tuple of float
@@ -120,6 +134,7 @@ class StudyConfig:
     resampling: tuple = RESAMPLING
     image_sizes: tuple = ((220, 175), (320, 240), (640, 480), (1280, 720))
     views: tuple = VIEWS
+    cameras: tuple = ("front+side", "45+-45", "front+45+side")
     compression: tuple = (0, 60, 20)
     noise: tuple = (0.0, 2.0, 5.0)
     baseline: dict = field(
@@ -162,6 +177,7 @@ LIST_KEYS = {
     "emotions": (lambda x: x in EMOTIONS, f"a list of emotions out of {', '.join(EMOTIONS)}"),
     "resampling": (lambda x: x in RESAMPLING, f"a list out of {', '.join(RESAMPLING)}"),
     "views": (lambda x: x in VIEWS, f"a list out of {', '.join(VIEWS)}"),
+    "cameras": (_is_cameras, f"a list of two or more views joined by '+' (views out of {', '.join(CAMERA_VIEWS)})"),
     "frame_rates": (lambda x: _is_num(x) and x > 0, "a list of frame rates in Hz (numbers > 0)"),
     "image_sizes": (
         lambda x: _seq(x) and len(x) == 2 and all(_is_int(n) and n >= 16 for n in x),
@@ -317,6 +333,7 @@ def quick(cfg: StudyConfig, phrases: tuple = ()) -> StudyConfig:
         frame_rates=ends(cfg.frame_rates),
         image_sizes=ends(cfg.image_sizes),
         views=ends(cfg.views),
+        cameras=ends(cfg.cameras),
         compression=ends(cfg.compression),
         noise=ends(cfg.noise),
         bootstrap=min(cfg.bootstrap, 10),

@@ -29,6 +29,15 @@ Capture paths (``capture`` in the study config):
     The same with the renderer's camera given to the fit (as ``c2n capture
     --calibration camera.toml`` would): the named calibrated condition.
 
+A condition of several cameras (``cameras`` factor: views joined by ``+``)
+is always calibrated, with the renderer's cameras: the truth path
+triangulates the jittered joints, the keypoint path fits the jittered
+landmarks of every camera with :func:`capture2notation.fitting.multiview.fit_views`
+(joints no two cameras see from the monocular fit of the camera that sees
+most of them, as a capture does), and the video
+path renders a clip per camera and captures them together
+(:func:`pipelines.capture.capture` with the cameras' calibration file).
+
 Only the kept frames of a condition reach the capture (the others are
 missing, never invented); the metrics that need a full-rate sequence use the
 captured frames linearly interpolated in time, as a capture system that
@@ -47,6 +56,7 @@ from capture2notation.compare.metrics import compare_movements, key_frames, mpjp
 from capture2notation.compare.resample import decimate, keyframe_resample
 from capture2notation.errors import C2NError, PipelineError
 from capture2notation.notation.model import PART_SEGMENTS, Score
+from pipelines.capture_multi import MONO_WEIGHT
 
 from .conditions import Condition, Performance, take_variation
 
@@ -131,10 +141,21 @@ def kept_frames(cond: Condition, score: Score, n_frames: int, fps: float) -> np.
     return keyframe_resample(n_frames, kf, cond.rate, Fraction(str(fps)))
 
 
-def _camera(cond: Condition, height: float):
+def _camera(cond: Condition, height: float, view: str | None = None):
     from synthetic.render.camera import Camera
 
-    return Camera.for_view(cond.view, size=(cond.width, cond.height), body_height=height)
+    return Camera.for_view(view or cond.view, size=(cond.width, cond.height), body_height=height)
+
+
+def _calibrated(cond: Condition, height: float) -> list:
+    """The condition's cameras: ``(render camera, CameraCalibration named by its view)`` each."""
+    from capture2notation.io.calibration import CameraCalibration
+
+    out = []
+    for view in cond.views:
+        cam = _camera(cond, height, view)
+        out.append((cam, CameraCalibration(view, (cond.width, cond.height), cam.K, np.zeros(5), cam.R, cam.t)))
+    return out
 
 
 def _jitter(uv: np.ndarray, cond: Condition, rng: np.random.Generator) -> np.ndarray:
@@ -181,6 +202,8 @@ def capture(
     T, J, _ = truth.shape
     out = np.full((T, J, 3), np.nan)
     conf = np.zeros((T, J))
+    if len(cond.views) > 1:
+        return _capture_cameras(mode, motion, kept, cond, rng, threads, out, conf)
     cam = _camera(cond, motion.body.height)
     if mode == "truth":
         p = truth[kept]
@@ -229,21 +252,108 @@ def capture(
     raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
 
 
+def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, threads: int, out, conf):
+    """:func:`capture` with several calibrated cameras (module docstring)."""
+    from capture2notation.fitting.multiview import fit_views
+    from capture2notation.fitting.triangulate import triangulate
+
+    cams = _calibrated(cond, motion.body.height)
+    if mode == "truth":
+        p = motion.joints()[kept]
+        uv = np.stack([_jitter(cam.project(p), cond, rng) for cam, _ in cams])
+        seen = np.stack([cam.in_image(u) for (cam, _), u in zip(cams, uv)])
+        uv[~seen] = np.nan
+        points, pconf, _ = triangulate(uv, seen.astype(float), [c for _, c in cams])
+        out[kept], conf[kept] = points, (pconf > 0).astype(float)
+        out[conf == 0] = np.nan
+        return out, conf
+    if mode == "keypoints":
+        from capture2notation.body import JOINTS
+        from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
+        from capture2notation.fitting import fit_keypoints
+        from capture2notation.fitting.camera import Camera as FitCamera
+        from synthetic.render.scene import Pose, landmark_visibility
+
+        pose = Pose.from_motion(motion)
+        lm = pose.landmarks[kept]
+        hip = 0.5 * (lm[:, 23] + lm[:, 24])
+        uv, vis, world = [], [], []
+        for cam, _ in cams:
+            v = landmark_visibility(pose, cam)[kept].astype(float)
+            u = _jitter(cam.project(lm), cond, rng)
+            u[v == 0] = np.nan
+            w = (lm - hip[:, None]) @ cam.R.T + rng.normal(0.0, WORLD_NOISE_M, lm.shape)
+            w[v == 0] = np.nan
+            uv.append(u)
+            vis.append(v)
+            world.append(w)
+        lm_of = np.array([JOINT_TO_BLAZEPOSE.get(n, -1) for n in JOINTS])
+
+        def fill(joints, jconf, missing, floor):
+            # As a capture does: the joints no two cameras saw, from the
+            # monocular fit of the camera that sees most of them.
+            seen = [float(np.sum(missing[:, lm_of >= 0] * v[:, lm_of[lm_of >= 0]])) for v in vis]
+            best = int(np.argmax(seen))
+            cam = cams[best][0]
+            mono = fit_keypoints(
+                uv[best], vis[best], motion.fps, camera=FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height)),
+                world=world[best], times=kept / motion.fps, image_size=(cond.width, cond.height),
+            )  # fmt: skip
+            ok = missing & np.all(np.isfinite(mono.joints), axis=-1)
+            joints = np.where(ok[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
+            return joints, np.where(ok, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
+
+        res, _floor = fit_views(
+            np.stack(uv), np.stack(vis), [c for _, c in cams], motion.fps, times=kept / motion.fps, fill=fill
+        )
+        out[kept], conf[kept] = res.joints, res.confidence
+        return out, conf
+    if mode == "video":
+        j, c = _capture_video(motion, kept, cond, rng, True, threads)
+        out[kept], conf[kept] = j[kept], c[kept]
+        out[conf == 0] = np.nan
+        return out, conf
+    raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
+
+
+def _render_take(path, renderer, shown, cond: Condition, fps: float, rng) -> None:
+    """Write the shown frames of a take to `path`, each held frame compressed alike with fresh noise."""
+    import cv2
+
+    from capture2notation.io.video import VideoWriter
+
+    image, drawn = None, -1
+    with VideoWriter(path, fps, (cond.width, cond.height)) as w:
+        for i in range(len(shown)):
+            if shown[i] != drawn:
+                drawn = int(shown[i])
+                image = renderer.frame(drawn)
+                if cond.compression:
+                    _ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
+                    image = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+            img = image
+            if cond.noise:
+                noisy = rng.standard_normal(image.shape, dtype=np.float32)
+                noisy *= cond.noise
+                noisy += image
+                img = np.clip(noisy, 0, 255, out=noisy).astype(np.uint8)
+            w.write(img)
+
+
 def _capture_video(motion, kept, cond: Condition, rng, calibrated: bool = False, threads: int = 2):
     """Render, degrade (hold, JPEG, noise) and capture a take; joints (T,J,3) and confidence (T,J).
 
     The renderer draws each shown frame once, straight into the video the
     capture reads (one H.264 generation, as a camera writes it); a held
     frame repeats the image of the frame it holds, compressed alike, with
-    fresh pixel noise.
+    fresh pixel noise.  Several cameras each get a clip
+    (``<view>/video.mp4``) and one calibration file.
     """
     import tempfile
     from pathlib import Path
 
-    import cv2
-
     from capture2notation.compare.resample import hold_map
-    from capture2notation.io.video import VideoWriter
+    from capture2notation.io.calibration import Calibration, write_calibration
     from pipelines.capture import capture as run_capture
     from synthetic.render.job import CAMERA_FILE, make_renderer, write_camera_toml
     from synthetic.render.scene import Pose
@@ -251,37 +361,34 @@ def _capture_video(motion, kept, cond: Condition, rng, calibrated: bool = False,
     T = motion.n_frames
     if T == 0:
         raise PipelineError("the performance has no frames to render")
-    cam = _camera(cond, motion.body.height)
-    renderer = make_renderer(Pose.from_motion(motion), cam, "mannequin")
+    pose = Pose.from_motion(motion)
     shown = hold_map(kept, T)
     with tempfile.TemporaryDirectory(prefix="c2n-fidelity-") as tmp:
         tmp = Path(tmp)
-        image, drawn = None, -1
-        with VideoWriter(tmp / "video.mp4", motion.fps, (cond.width, cond.height)) as w:
-            for i in range(T):
-                if shown[i] != drawn:
-                    drawn = int(shown[i])
-                    image = renderer.frame(drawn)
-                    if cond.compression:
-                        _ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, int(cond.compression)])
-                        image = cv2.imdecode(buf, cv2.IMREAD_COLOR)
-                img = image
-                if cond.noise:
-                    noisy = rng.standard_normal(image.shape, dtype=np.float32)
-                    noisy *= cond.noise
-                    noisy += image
-                    img = np.clip(noisy, 0, 255, out=noisy).astype(np.uint8)
-                w.write(img)
-        if calibrated:
-            write_camera_toml(cam, tmp / CAMERA_FILE, name="video")
+        if len(cond.views) > 1:
+            cams = _calibrated(cond, motion.body.height)
+            videos = []
+            for cam, calib in cams:
+                (tmp / calib.name).mkdir()
+                videos.append(tmp / calib.name / "video.mp4")
+                _render_take(videos[-1], make_renderer(pose, cam, "mannequin"), shown, cond, motion.fps, rng)
+            write_calibration(Calibration.of([c for _, c in cams]), tmp / "cameras.toml")
+            source, calibration = [str(v) for v in videos], tmp / "cameras.toml"
+        else:
+            cam = _camera(cond, motion.body.height)
+            _render_take(tmp / "video.mp4", make_renderer(pose, cam, "mannequin"), shown, cond, motion.fps, rng)
+            source, calibration = tmp / "video.mp4", None
+            if calibrated:
+                write_camera_toml(cam, tmp / CAMERA_FILE, name="video")
+                calibration = tmp / CAMERA_FILE
         run_capture(
-            tmp / "video.mp4",
+            source,
             tmp / "capture",
             effort=False,
             overlay=False,
             progress=False,
             seed=int(rng.integers(2**31)),
-            calibration=tmp / CAMERA_FILE if calibrated else None,
+            calibration=calibration,
             threads=threads,
         )
         with np.load(tmp / "capture" / "capture.npz") as z:

@@ -150,6 +150,7 @@ def conclusions(table: list[dict], summary: dict) -> list[str]:
         "frame_rate": "frame rate",
         "image_size": "image size",
         "view": "viewpoint",
+        "cameras": "calibrated cameras",
         "compression": "compression",
         "noise": "pixel noise",
     }
@@ -314,6 +315,7 @@ def _figures(rep: Report, result, table) -> None:
     for factor, title in (
         ("image_size", "image size"),
         ("view", "viewpoint"),
+        ("cameras", "the number and placement of calibrated cameras"),
         ("compression", "compression"),
         ("noise", "pixel noise"),
     ):
@@ -346,6 +348,8 @@ def _with_baseline(table, factor) -> list[dict]:
     if factor == "view":
         order = ("front", "45", "side")
         return sorted(lv, key=lambda t: order.index(_level(t, factor)) if _level(t, factor) in order else 9)
+    if factor == "cameras":  # one camera (the baseline), then by how many
+        return sorted(lv, key=lambda t: len(_level(t, factor).split("+")))
     if factor == "noise":
         return sorted(lv, key=lambda t: float(_level(t, factor).split("=")[1]))
     return lv
@@ -361,6 +365,7 @@ def _level(t, factor) -> str:
         "frame_rate": parts[0],
         "image_size": parts[1],
         "view": parts[2],
+        "cameras": parts[2],
         "compression": parts[3],
         "noise": parts[4],
     }

@@ -16,6 +16,7 @@ def tiny_study() -> dict:
         resampling=("keyframe",),
         image_sizes=((320, 240),),
         views=("front",),
+        cameras=(),
         compression=(0,),
         noise=(0.0,),
         bootstrap=3,
