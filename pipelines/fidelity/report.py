@@ -174,6 +174,10 @@ def conclusions(table: list[dict], summary: dict) -> list[str]:
         s = f"{name.capitalize()}: sufficient — {', '.join(good) if good else 'none of the levels tried'}."
         if bad:
             s += f" Not sufficient — {'; '.join(bad)}."
+        if factor == "cameras":
+            # What a second or third camera buys, in the figure it changes most.
+            s += " Limb angle error: " + ", ".join(f"{_level(t, factor)} {t['angle_error_deg']:.1f}°" for t in measured)
+            s += " (several cameras are calibrated with the renderer's cameras and triangulated)."
         lines.append(s)
     for method, s in summary.get("experiment2", {}).items():
         rates = ", ".join(f"{k:g} Hz {v:.0f} %" for k, v in sorted(s["by_frame_rate"].items()))

@@ -296,3 +296,14 @@ def test_a_second_camera_buys_the_depth_one_side_view_lacks(mode):
     assert errors["front+side"] < 5.0
     if mode == "keypoints":
         assert errors["side"] > 2 * errors["front+side"]
+
+
+def test_conclusions_say_what_more_cameras_buy_in_limb_angle():
+    from pipelines.fidelity.report import conclusions
+
+    base = "25 Hz keyframe, 640x480, front, q=none, noise=0"
+    two = dict(_line("cameras", "25 Hz keyframe, 640x480, front+side, q=none, noise=0", 0.95, 80.0))
+    two["angle_error_deg"] = 2.5
+    text = " ".join(conclusions([_line("baseline", base, 0.90, 80.0), two], {}))
+    assert "Calibrated cameras: sufficient — front, front+side." in text
+    assert "Limb angle error: front 5.0°, front+side 2.5°" in text
