@@ -202,8 +202,14 @@ def capture(
     T, J, _ = truth.shape
     out = np.full((T, J, 3), np.nan)
     conf = np.zeros((T, J))
+    if mode == "video":
+        # Several cameras are calibrated by construction.
+        j, c = _capture_video(motion, kept, cond, rng, calibrated or len(cond.views) > 1, threads)
+        out[kept], conf[kept] = j[kept], c[kept]
+        out[conf == 0] = np.nan
+        return out, conf
     if len(cond.views) > 1:
-        return _capture_cameras(mode, motion, kept, cond, rng, threads, out, conf)
+        return _capture_cameras(mode, motion, kept, cond, rng, out, conf)
     cam = _camera(cond, motion.body.height)
     if mode == "truth":
         p = truth[kept]
@@ -218,17 +224,9 @@ def capture(
     if mode == "keypoints":
         from capture2notation.fitting import fit_keypoints
         from capture2notation.fitting.camera import Camera as FitCamera
-        from synthetic.render.scene import Pose, landmark_visibility
+        from synthetic.render.scene import Pose
 
-        pose = Pose.from_motion(motion)
-        lm = pose.landmarks[kept]
-        vis = landmark_visibility(pose, cam)[kept]
-        uv = _jitter(cam.project(lm), cond, rng)
-        uv[vis == 0] = np.nan
-        # BlazePose's world landmarks: hip-centred, camera-aligned axes, metres.
-        hip = 0.5 * (lm[:, 23] + lm[:, 24])
-        world = (lm - hip[:, None]) @ cam.R.T + rng.normal(0.0, WORLD_NOISE_M, lm.shape)
-        world[vis == 0] = np.nan
+        uv, vis, world = _simulated_landmarks(Pose.from_motion(motion), cam, kept, cond, rng)
         fitcam = FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height)) if calibrated else None
         res = fit_keypoints(
             uv,
@@ -244,16 +242,31 @@ def capture(
         out[kept] = res.joints
         conf[kept] = res.confidence
         return out, conf
-    if mode == "video":
-        j, c = _capture_video(motion, kept, cond, rng, calibrated, threads)
-        out[kept], conf[kept] = j[kept], c[kept]
-        out[conf == 0] = np.nan
-        return out, conf
     raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
 
 
-def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, threads: int, out, conf):
-    """:func:`capture` with several calibrated cameras (module docstring)."""
+def _simulated_landmarks(pose, cam, kept, cond: Condition, rng):
+    """BlazePose-like landmarks of the kept frames in one camera.
+
+    Returns pixels (M, 33, 2), jittered and NaN where the renderer's
+    self-occlusion test hides a landmark; visibility (M, 33) in {0, 1}; and
+    world landmarks (M, 33, 3): hip-centred, camera-aligned axes, metres,
+    with Gaussian noise of :data:`WORLD_NOISE_M`.
+    """
+    from synthetic.render.scene import landmark_visibility
+
+    lm = pose.landmarks[kept]
+    vis = landmark_visibility(pose, cam)[kept].astype(float)
+    uv = _jitter(cam.project(lm), cond, rng)
+    uv[vis == 0] = np.nan
+    hip = 0.5 * (lm[:, 23] + lm[:, 24])
+    world = (lm - hip[:, None]) @ cam.R.T + rng.normal(0.0, WORLD_NOISE_M, lm.shape)
+    world[vis == 0] = np.nan
+    return uv, vis, world
+
+
+def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, out, conf):
+    """:func:`capture` with several calibrated cameras, truth and keypoint paths (module docstring)."""
     from capture2notation.fitting.multiview import fit_views
     from capture2notation.fitting.triangulate import triangulate
 
@@ -272,21 +285,10 @@ def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, threads: int
         from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
         from capture2notation.fitting import fit_keypoints
         from capture2notation.fitting.camera import Camera as FitCamera
-        from synthetic.render.scene import Pose, landmark_visibility
+        from synthetic.render.scene import Pose
 
         pose = Pose.from_motion(motion)
-        lm = pose.landmarks[kept]
-        hip = 0.5 * (lm[:, 23] + lm[:, 24])
-        uv, vis, world = [], [], []
-        for cam, _ in cams:
-            v = landmark_visibility(pose, cam)[kept].astype(float)
-            u = _jitter(cam.project(lm), cond, rng)
-            u[v == 0] = np.nan
-            w = (lm - hip[:, None]) @ cam.R.T + rng.normal(0.0, WORLD_NOISE_M, lm.shape)
-            w[v == 0] = np.nan
-            uv.append(u)
-            vis.append(v)
-            world.append(w)
+        uv, vis, world = zip(*(_simulated_landmarks(pose, cam, kept, cond, rng) for cam, _ in cams))
         lm_of = np.array([JOINT_TO_BLAZEPOSE.get(n, -1) for n in JOINTS])
 
         def fill(joints, jconf, missing, floor):
@@ -307,11 +309,6 @@ def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, threads: int
             np.stack(uv), np.stack(vis), [c for _, c in cams], motion.fps, times=kept / motion.fps, fill=fill
         )
         out[kept], conf[kept] = res.joints, res.confidence
-        return out, conf
-    if mode == "video":
-        j, c = _capture_video(motion, kept, cond, rng, True, threads)
-        out[kept], conf[kept] = j[kept], c[kept]
-        out[conf == 0] = np.nan
         return out, conf
     raise PipelineError(f"capture path {mode!r} is not available; use 'truth', 'keypoints' or 'video'")
 
