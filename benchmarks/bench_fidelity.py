@@ -126,6 +126,7 @@ def bench_workers(capture: str = "keypoints", repeats: int = 2) -> None:
         resampling=("keyframe",),
         image_sizes=((320, 240),),
         views=("front",),
+        cameras=(),
         compression=(0,),
         noise=(0.0,),
         bootstrap=10,

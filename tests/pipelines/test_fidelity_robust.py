@@ -93,6 +93,7 @@ frame_rates = [25, 5]
 resampling = ["keyframe"]
 image_sizes = [[320, 240]]
 views = ["front"]
+cameras = []
 compression = [0]
 noise = [0]
 bootstrap = 3

@@ -79,6 +79,7 @@ def test_fidelity_report_in_chromium(tmp_path, chromium):
         resampling=("naive",),
         image_sizes=((220, 175), (640, 480)),
         views=("front",),
+        cameras=("front+side",),
         compression=(0,),
         noise=(0.0,),
         bootstrap=3,
@@ -94,6 +95,7 @@ def test_fidelity_report_in_chromium(tmp_path, chromium):
             "plots/fig316_frame_rate.png",
             "plots/recovery_frame_rate.png",
             "plots/factor_image_size.png",
+            "plots/factor_cameras.png",
         },
     )
     html = (tmp_path / "study" / "report.html").read_text()
