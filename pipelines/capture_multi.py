@@ -134,12 +134,6 @@ def _align(tracks, offsets_s, videos, fps: float):
     return [slice(start - s, stop - s) for s in shifts]
 
 
-#: Weight of a joint taken from one view's monocular fit where the other
-#: views do not see it: depth from one view is the weak direction, so the
-#: fit's priors and the triangulated neighbours count for more.
-MONO_WEIGHT = 0.3
-
-
 def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, floor: float = 0.0):
     """Joints no two views saw, from the monocular fit of the view that sees them best.
 
@@ -150,27 +144,20 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     -------
     joints : (T, J, 3) ndarray
     jconf : (T, J) ndarray
-        :data:`MONO_WEIGHT` × the monocular fit's confidence where filled.
+        :data:`~capture2notation.fitting.multiview.MONO_WEIGHT` × the
+        monocular fit's confidence where filled.
 
     `floor` is the height subtracted from the triangulated joints, metres
     (the monocular fit is in the calibration's world, so it is shifted alike).
     """
     from dataclasses import replace
 
-    from capture2notation.body import JOINTS
-    from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
     from capture2notation.fitting import Camera, fit_track
     from capture2notation.fitting.camera import undistort_track
+    from capture2notation.fitting.multiview import fill_view, filled
     from capture2notation.io.calibration import read_calibration
 
-    seen = []
-    for t, s in zip(tracks, spans):
-        vis = np.zeros(missing.shape)
-        for j, name in enumerate(JOINTS):
-            if name in JOINT_TO_BLAZEPOSE:
-                vis[:, j] = np.nan_to_num(t.visibility[s, JOINT_TO_BLAZEPOSE[name]])
-        seen.append(float(np.sum(np.where(missing, vis, 0.0))))
-    best = int(np.argmax(seen))
+    best = fill_view([t.visibility[s] for t, s in zip(tracks, spans)], missing)
     track, span = tracks[best], spans[best]
     cut = replace(
         track,
@@ -187,10 +174,7 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     camera = Camera.from_calibration(known, videos[best], track.image_size, undistorted=True)
     mono = fit_track(cut, camera=camera)
     log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
-    fill = missing & np.all(np.isfinite(mono.joints), axis=-1)
-    joints = np.where(fill[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
-    jconf = np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
-    return joints, jconf
+    return filled(joints, jconf, missing, mono, floor)
 
 
 def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int):

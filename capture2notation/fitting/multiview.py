@@ -14,6 +14,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..body import JOINTS
+from ..body.skeleton import JOINT_TO_BLAZEPOSE
 from ..errors import C2NError, FittingError
 from .camera import Camera
 from .fit3d import fit_points3d
@@ -28,9 +30,44 @@ from .triangulate import (
     undistorted_pixels,
 )
 
-__all__ = ["fit_views"]
+__all__ = ["MONO_WEIGHT", "fill_view", "filled", "fit_views"]
 
 log = logging.getLogger(__name__)
+
+#: Weight of a joint taken from one view's monocular fit where the other
+#: views do not see it: depth from one view is the weak direction, so the
+#: fit's priors and the triangulated neighbours count for more.
+MONO_WEIGHT = 0.3
+
+#: (J,) BlazePose landmark of each joint, -1 for joints no landmark is.
+_LANDMARK_OF = np.array([JOINT_TO_BLAZEPOSE.get(name, -1) for name in JOINTS])
+
+
+def fill_view(visibility, missing) -> int:
+    """The view whose keypoints see the `missing` joints best (summed visibility).
+
+    Parameters
+    ----------
+    visibility : sequence of V (T, 33) ndarrays
+        Each view's landmark visibilities (NaN counts as 0).
+    missing : (T, J) ndarray of bool
+        Joints no two views saw.
+    """
+    has = _LANDMARK_OF >= 0
+    seen = [float(np.sum(missing[:, has] * np.nan_to_num(np.asarray(v)[:, _LANDMARK_OF[has]]))) for v in visibility]
+    return int(np.argmax(seen))
+
+
+def filled(joints, jconf, missing, mono: FitResult, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """`joints` and `jconf` (T, J) with the `missing` joints taken from a monocular fit.
+
+    `mono` is in the cameras' world; `floor` (metres) is subtracted from it as
+    from the triangulated joints.  A filled joint's confidence is
+    :data:`MONO_WEIGHT` × the monocular fit's.
+    """
+    fill = missing & np.all(np.isfinite(mono.joints), axis=-1)
+    joints = np.where(fill[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
+    return joints, np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
 
 
 def fit_views(
@@ -57,7 +94,8 @@ def fit_views(
     fill : callable, optional
         ``fill(joints, conf, missing, floor) -> (joints, conf)`` supplies the
         landmark joints no two views saw (``missing``, (T, J) bool), in the
-        floor-shifted world, e.g. from one view's monocular fit; without it
+        floor-shifted world, e.g. from one view's monocular fit
+        (:func:`fill_view`, :func:`filled`); without it
         they are left to the fit's skeleton (confidence 0).  The trunk and
         head are never filled: a guess of them would pull the fit's spine.
 

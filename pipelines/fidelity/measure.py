@@ -56,7 +56,6 @@ from capture2notation.compare.metrics import compare_movements, key_frames, mpjp
 from capture2notation.compare.resample import decimate, keyframe_resample
 from capture2notation.errors import C2NError, PipelineError
 from capture2notation.notation.model import PART_SEGMENTS, Score
-from pipelines.capture_multi import MONO_WEIGHT
 
 from .conditions import Condition, Performance, take_variation
 
@@ -281,29 +280,24 @@ def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, out, conf):
         out[conf == 0] = np.nan
         return out, conf
     if mode == "keypoints":
-        from capture2notation.body import JOINTS
-        from capture2notation.body.skeleton import JOINT_TO_BLAZEPOSE
         from capture2notation.fitting import fit_keypoints
         from capture2notation.fitting.camera import Camera as FitCamera
+        from capture2notation.fitting.multiview import fill_view, filled
         from synthetic.render.scene import Pose
 
         pose = Pose.from_motion(motion)
         uv, vis, world = zip(*(_simulated_landmarks(pose, cam, kept, cond, rng) for cam, _ in cams))
-        lm_of = np.array([JOINT_TO_BLAZEPOSE.get(n, -1) for n in JOINTS])
 
         def fill(joints, jconf, missing, floor):
             # As a capture does: the joints no two cameras saw, from the
             # monocular fit of the camera that sees most of them.
-            seen = [float(np.sum(missing[:, lm_of >= 0] * v[:, lm_of[lm_of >= 0]])) for v in vis]
-            best = int(np.argmax(seen))
+            best = fill_view(vis, missing)
             cam = cams[best][0]
             mono = fit_keypoints(
                 uv[best], vis[best], motion.fps, camera=FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height)),
                 world=world[best], times=kept / motion.fps, image_size=(cond.width, cond.height),
             )  # fmt: skip
-            ok = missing & np.all(np.isfinite(mono.joints), axis=-1)
-            joints = np.where(ok[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
-            return joints, np.where(ok, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
+            return filled(joints, jconf, missing, mono, floor)
 
         res, _floor = fit_views(
             np.stack(uv), np.stack(vis), [c for _, c in cams], motion.fps, times=kept / motion.fps, fill=fill
