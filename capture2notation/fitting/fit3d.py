@@ -16,6 +16,8 @@ scale :data:`VIEW_SCALE_PX`).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..body import JOINTS, Body
@@ -187,10 +189,9 @@ def _fit_views(model: PoseModel, params, terms: Terms, views, fps: float, opt: F
         idx = np.array([model.index(n) for n in names])
         seen = np.all(np.isfinite(uv), axis=-1)
         prepared.append((cam, idx, np.where(seen[..., None], uv, np.nan), np.where(seen, np.clip(vis, 0, 1), 0.0)))
-    terms.w3 = terms.w3 * VIEW_3D_WEIGHT
-    if terms.wd is not None:
-        terms.wd = terms.wd * VIEW_3D_WEIGHT
+    wd = None if terms.wd is None else terms.wd * VIEW_3D_WEIGHT
     for _ in range(VIEW_ROUNDS):
-        terms.views = _view_weights(model, params, prepared)
-        params, _ = solve(model, params, terms, fps, opt, VIEW_ITERATIONS, frozen=np.zeros(0, int))
+        views = _view_weights(model, params, prepared)
+        refit = replace(terms, w3=terms.w3 * VIEW_3D_WEIGHT, wd=wd, views=views)
+        params, _ = solve(model, params, refit, fps, opt, VIEW_ITERATIONS, frozen=np.zeros(0, int))
     return params

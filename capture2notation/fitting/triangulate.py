@@ -245,12 +245,19 @@ def _forward(left_to_right: np.ndarray) -> np.ndarray:
 HEAD_MIN_M = 0.04
 
 
-def _head_forward(uv, vis, cameras, min_m: float = 0.0) -> np.ndarray:
-    """The nose's offset (T, 3) from the ears' midpoint, triangulated (NaN under `min_m` seen from above).
+def _head_and_shoulders(uv, vis, cameras, min_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Where the head faces, and the shoulders' left → right vector, triangulated.
 
-    Unchanged by swapping the ears' labels in either view: the nose has
-    none, and the two ear points keep their midpoint.  Where the ears are
-    not both triangulated, from the shoulders' midpoint.
+    Returns
+    -------
+    head : (T, 3) ndarray
+        The nose's offset from the ears' midpoint; NaN under `min_m` seen
+        from above.  Unchanged by swapping the ears' labels in either view:
+        the nose has none, and the two ear points keep their midpoint.
+        Where the ears are not both triangulated, from the shoulders'
+        midpoint.
+    shoulders : (T, 3) ndarray
+        Right shoulder minus left shoulder.
     """
     P, _, _ = triangulate(uv[:, :, [0, 7, 8, 11, 12]], vis[:, :, [0, 7, 8, 11, 12]], cameras)
     h = P[:, 0] - 0.5 * (P[:, 1] + P[:, 2])
@@ -259,7 +266,19 @@ def _head_forward(uv, vis, cameras, min_m: float = 0.0) -> np.ndarray:
     # which a relabelling moves little, stands in for the ears'.
     h = np.where(np.isfinite(h), h, P[:, 0] - 0.5 * (P[:, 3] + P[:, 4]))
     # A head tilted far up or down says little about where it faces.
-    return np.where(np.linalg.norm(h[:, :2], axis=1, keepdims=True) >= min_m, h, np.nan)
+    head = np.where(np.linalg.norm(h[:, :2], axis=1, keepdims=True) >= min_m, h, np.nan)
+    return head, P[:, 4] - P[:, 3]
+
+
+def _group_labels(pairs) -> tuple[np.ndarray, np.ndarray]:
+    """A group's landmark indices, and the same with left and right exchanged."""
+    return np.array([i for ab in pairs for i in ab]), np.array([i for a, b in pairs for i in (b, a)])
+
+
+def _relabel(uv, vis, v: int, frames, idx, alt) -> None:
+    """Exchange left and right of one group in view `v` at `frames`, in place."""
+    uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
+    vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
 
 
 def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -301,8 +320,7 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
     for v in range(1, V):
         pair = [cameras[0], cameras[v]]
         for g, pairs in enumerate(SIDE_GROUPS.values()):
-            idx = np.array([i for ab in pairs for i in ab])
-            alt = np.array([i for a, b in pairs for i in (b, a)])
+            idx, alt = _group_labels(pairs)
             keep, v_keep = _group_error(
                 np.stack([uv[0][:, idx], uv[v][:, idx]]), np.stack([vis[0][:, idx], vis[v][:, idx]]), pair
             )
@@ -312,7 +330,7 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
             if g == 0:
                 # Where reprojection cannot tell, the shoulders face where the head does.
                 tie = np.abs(swap - keep) < SIDE_AMBIGUOUS_PX
-                head = _head_forward(uv[[0, v]], vis[[0, v]], pair)
+                head, _ = _head_and_shoulders(uv[[0, v]], vis[[0, v]], pair)
                 c_keep = _horizontal_cos(_forward(v_keep), head)
                 c_swap = _horizontal_cos(_forward(v_swap), head)
                 # ... and only where the two labellings turn the shoulders apart.
@@ -327,11 +345,10 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
                 keep = np.where(_horizontal_cos(v_keep, shoulders) < limit, 1e6, keep)
                 swap = np.where(_horizontal_cos(v_swap, shoulders) < limit, 1e6, swap)
             frames = _swap_frames(keep, swap)
-            uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
-            vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
+            _relabel(uv, vis, v, frames, idx, alt)
             swapped[v, :, g] = frames
     if V >= 2:
-        uv, vis, swapped = _unmirror(uv, vis, cameras, swapped)
+        _unmirror(uv, vis, cameras, swapped)
     return uv, vis, swapped
 
 
@@ -341,8 +358,8 @@ def match_sides(uv, visibility, cameras) -> tuple[np.ndarray, np.ndarray, np.nda
 MIRRORED_COS = -0.7
 
 
-def _unmirror(uv, vis, cameras, swapped):
-    """Swap left and right in every view where the triangulated body is mirrored.
+def _unmirror(uv, vis, cameras, swapped) -> None:
+    """Swap left and right in every view where the triangulated body is mirrored, in place.
 
     Matching makes the views agree with the first view, so where the keypoint
     model mirrored the first view (a back view read as a front view) every
@@ -351,22 +368,17 @@ def _unmirror(uv, vis, cameras, swapped):
     the ears' midpoint, which no relabelling moves); its hips turn with its
     shoulders, so both groups are swapped, in every view.
     """
-    arms = np.array([i for ab in SIDE_GROUPS["arms"][:1] for i in ab])
-    P, _, _ = triangulate(uv[:, :, arms], vis[:, :, arms], cameras)
-    cos = _horizontal_cos(_forward(P[:, 1] - P[:, 0]), _head_forward(uv, vis, cameras, HEAD_MIN_M))
+    head, shoulders = _head_and_shoulders(uv, vis, cameras, HEAD_MIN_M)
+    cos = _horizontal_cos(_forward(shoulders), head)
     score = np.where(np.isfinite(cos), cos - MIRRORED_COS, 0.0)
     frames = median_filter(score, size=SIDE_MEDIAN_FRAMES, mode="nearest") < 0
     if not frames.any():
-        return uv, vis, swapped
-    uv, vis, swapped = uv.copy(), vis.copy(), swapped.copy()
+        return
     for g, pairs in enumerate(SIDE_GROUPS.values()):
-        idx = np.array([i for ab in pairs for i in ab])
-        alt = np.array([i for a, b in pairs for i in (b, a)])
+        idx, alt = _group_labels(pairs)
         for v in range(uv.shape[0]):
-            uv[v][np.ix_(frames, idx)] = uv[v][np.ix_(frames, alt)]
-            vis[v][np.ix_(frames, idx)] = vis[v][np.ix_(frames, alt)]
+            _relabel(uv, vis, v, frames, idx, alt)
             swapped[v, frames, g] = ~swapped[v, frames, g]
-    return uv, vis, swapped
 
 
 #: (J,) bool: the joints :func:`landmarks_to_joints` measures, those a
