@@ -441,15 +441,18 @@ def capture(
             _check_options(backend, tempo, fps_override)
             for v in input_path:
                 input_kind(v)  # a missing file or an unknown type, named
-            motion, seconds, per_view, source = load_views(
+            motion, seconds, views, source = load_views(
                 input_path, calibration, backend, fps_override, progress, offsets=offsets, overlay=overlay,
                 flip_test=flip_test,
             )  # fmt: skip
-            return notate(
-                motion, None, seconds, input_path=Path(input_path[0]), outdir=outdir, kind="multiview", tempo=tempo,
-                meter=meter, params=params, effort=effort, seed=seed, overlay=overlay, axes=axes,
-                camera=(None, source), extra_outputs=per_view, workers=workers,
-            )  # fmt: skip
+            try:
+                return notate(
+                    motion, None, seconds, input_path=Path(input_path[0]), outdir=outdir, kind="multiview",
+                    tempo=tempo, meter=meter, params=params, effort=effort, seed=seed, overlay=overlay, axes=axes,
+                    camera=(None, source), extra_outputs=views, workers=workers,
+                )  # fmt: skip
+            finally:
+                views.close()
     elif offsets is not None:
         raise PipelineError("--offsets is for several clips (one per camera)")
     _check_options(backend, tempo, fps_override)

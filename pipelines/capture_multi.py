@@ -15,6 +15,8 @@ outputs (:func:`pipelines.capture.notate`, called by
 from __future__ import annotations
 
 import logging
+import shutil
+import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -23,7 +25,7 @@ import numpy as np
 
 from capture2notation.errors import PipelineError
 
-__all__ = ["MAX_AUTO_LAG_S", "check_views", "load_views", "parse_offsets"]
+__all__ = ["MAX_AUTO_LAG_S", "ViewFiles", "check_views", "load_views", "parse_offsets"]
 
 log = logging.getLogger(__name__)
 
@@ -199,6 +201,58 @@ def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int)
         return list(pool.map(one, videos))
 
 
+class ViewFiles:
+    """Each camera's ``keypoints_<camera>.npz`` and ``overlay_<camera>.mp4``.
+
+    The overlays (decode, draw, encode: OpenCV and the encoder release the
+    GIL) are drawn on one thread from the moment the keypoints exist, into a
+    scratch folder, while the fit holds the other core; calling the object
+    with the capture's staging folder waits for them and moves them in.
+    :meth:`close` discards whatever was not moved.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Camera names.
+    videos : sequence of Path
+    tracks : sequence of KeypointTrack
+    overlay : bool
+        Draw the overlays.
+    """
+
+    def __init__(self, names, videos, tracks, overlay: bool):
+        self._tracks = dict(zip(names, tracks))
+        self._pool = self._scratch = None
+        self._drawings = {}
+        if overlay:
+            from capture2notation.keypoints.overlay import write_overlay
+
+            self._scratch = Path(tempfile.mkdtemp(prefix="c2n-overlays-"))
+            self._pool = ThreadPoolExecutor(max_workers=1)
+            self._drawings = {
+                name: self._pool.submit(
+                    write_overlay, video, track, self._scratch / f"overlay_{name}.mp4", fps=track.fps
+                )
+                for name, video, track in zip(names, videos, tracks)
+            }
+
+    def __call__(self, stage: Path) -> dict:
+        """Write the keypoints into `stage`, move the finished overlays there; ``{file name: path}``."""
+        files = {f"keypoints_{n}.npz": t.save(stage / f"keypoints_{n}.npz") for n, t in self._tracks.items()}
+        for name, drawing in self._drawings.items():
+            files[f"overlay_{name}.mp4"] = Path(shutil.move(drawing.result(), stage / f"overlay_{name}.mp4"))
+        return files
+
+    def close(self) -> None:
+        """Stop drawing (a view already started is finished) and remove the scratch folder."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+        if self._scratch is not None:
+            shutil.rmtree(self._scratch, ignore_errors=True)
+            self._scratch = None
+
+
 def load_views(
     videos,
     calibration,
@@ -235,9 +289,10 @@ def load_views(
         In the calibration's world, the floor moved to z = 0.
     seconds : dict
         Time per stage.
-    per_view : callable
-        ``per_view(folder) -> dict`` writes ``keypoints_<camera>.npz`` (and
-        overlays) into `folder` (for :func:`pipelines.capture.notate`).
+    views : ViewFiles
+        ``views(folder) -> dict`` writes ``keypoints_<camera>.npz`` and moves
+        the overlays into `folder` (for :func:`pipelines.capture.notate`);
+        the caller closes it.
     source : str
         The cameras used, for the page.
     """
@@ -279,22 +334,16 @@ def load_views(
         return out
 
     times = np.asarray(tracks[0].times)[spans[0]]
+    names = [camera_name(v) for v in videos]
+    views = ViewFiles(names, videos, tracks, overlay)
     try:
         motion, _floor = fit_views(uv, vis, cameras, fps, times=times - times[0], fill=fill)
     except FittingError as exc:
+        views.close()
         raise PipelineError(f"{videos[0]}: {exc}") from None
+    except BaseException:
+        views.close()
+        raise
     seconds["triangulate and fit"] = time.perf_counter() - t0 - seconds.get("monocular", 0.0)
-    names = [camera_name(v) for v in videos]
-
-    def per_view(stage: Path) -> dict:
-        files = {}
-        for name, video, track in zip(names, videos, tracks):
-            files[f"keypoints_{name}.npz"] = track.save(stage / f"keypoints_{name}.npz")
-            if overlay:
-                from capture2notation.keypoints.overlay import write_overlay
-
-                files[f"overlay_{name}.mp4"] = write_overlay(video, track, stage / f"overlay_{name}.mp4", fps=track.fps)
-        return files
-
     source = f"calibration {calibration} ({', '.join(names)})"
-    return motion, seconds, per_view, source
+    return motion, seconds, views, source

@@ -114,6 +114,30 @@ def test_two_view_marker_capture_writes_every_output(two_views, tmp_path):
     assert res.n_frames == read_truth(root / "front" / "truth.npz").n_frames
 
 
+def test_a_failed_fit_leaves_no_overlays_drawn_beside_it(two_views, tmp_path, monkeypatch):
+    # The overlays are drawn while the fit runs: a fit that fails must not
+    # leave their scratch folder or a partial output behind.
+    import importlib
+
+    from capture2notation.errors import FittingError
+
+    _, root = two_views
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr("tempfile.tempdir", str(scratch))
+    def fail(*args, **kwargs):
+        raise FittingError("no joint was seen by two cameras at once")
+
+    monkeypatch.setattr(importlib.import_module("capture2notation.fitting.multiview"), "fit_views", fail)
+    with pytest.raises(PipelineError, match="two cameras"):
+        capture(
+            [root / v / "video.mp4" for v in VIEWS], tmp_path / "out", backend="markers", tempo=60,
+            calibration=root / "cameras.toml", progress=False, effort=False,
+        )  # fmt: skip
+    assert list(scratch.iterdir()) == []
+    assert not (tmp_path / "out").exists()
+
+
 def test_the_spine_is_placed_by_the_fit_not_by_one_views_guess(two_views, tmp_path, monkeypatch):
     """Exact keypoints from both views: every landmark joint is triangulated, and the
     waist and chest, which no landmark measures, come out where the dancer's are
