@@ -125,6 +125,7 @@ def test_a_failed_fit_leaves_no_overlays_drawn_beside_it(two_views, tmp_path, mo
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     monkeypatch.setattr("tempfile.tempdir", str(scratch))
+
     def fail(*args, **kwargs):
         raise FittingError("no joint was seen by two cameras at once")
 
