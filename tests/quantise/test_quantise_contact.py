@@ -3,7 +3,7 @@
 import numpy as np
 
 from capture2notation.body import Body, joint_index
-from capture2notation.quantise.contact import decode_contacts
+from capture2notation.quantise.contact import MAX_FLOOR_OFFSET_M, MIN_HEIGHT_SD_M, decode_contacts
 from capture2notation.quantise.labels import support_frames
 
 FPS = 100.0
@@ -78,3 +78,35 @@ def test_feet_far_above_the_floor_are_in_the_air():
     assert not decode_contacts(p, FPS).any()
     p[..., 2] -= 0.10
     assert decode_contacts(p, FPS).all()
+
+
+def test_a_stance_the_fit_lifts_by_centimetres_stays_on_the_floor():
+    """A fitted foot's points drift above the sole it stands on (BlazePose's
+    ankle and toe, the body model's foot): the grounded level is the clip's
+    own, fitted by the decoder, within :data:`MAX_FLOOR_OFFSET_M`."""
+    rng = np.random.default_rng(11)
+    fps, T = 25.0, 300
+    p = _standing(T, rng, 0.0)
+    for part in ("ankle", "toe"):
+        p[:, joint_index(f"right_{part}"), 2] += np.linspace(0.0, 0.05, T)  # 0 -> 5 cm over 12 s
+        p[:, joint_index(f"left_{part}"), 2] += 0.025
+    _lift(p, "left", 120, 280, 0.3)  # the other leg gestures meanwhile
+    p += rng.normal(0, 0.006, p.shape)
+    c = decode_contacts(p, fps)
+    assert c[:, 0].all()
+    assert c[:115, 1].all() and c[285:, 1].all() and not c[140:260, 1].any()
+
+
+def test_a_foot_held_a_hand_above_the_floor_is_not_on_it():
+    # A low gesture held still, 8 cm up, while the other foot stands: above
+    # the highest grounded level believed by more than three of this clip's
+    # grounded scatter (4 mm jitter: the least scatter, MIN_HEIGHT_SD_M).
+    held = 0.08
+    assert held - MAX_FLOOR_OFFSET_M > 3 * MIN_HEIGHT_SD_M
+    rng = np.random.default_rng(12)
+    fps, T = 25.0, 300
+    p = _standing(T, rng, 0.004)
+    for part in ("ankle", "toe", "knee"):
+        p[100:200, joint_index(f"right_{part}"), 2] += held
+    c = decode_contacts(p, fps)
+    assert not c[105:195, 0].any() and c[:95, 0].all() and c[:, 1].all()
