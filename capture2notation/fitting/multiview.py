@@ -62,11 +62,38 @@ def filled(joints, jconf, missing, mono: FitResult, floor: float) -> tuple[np.nd
     """`joints` and `jconf` (T, J) with the `missing` joints taken from a monocular fit.
 
     `mono` is in the cameras' world; `floor` (metres) is subtracted from it as
-    from the triangulated joints.  A filled joint's confidence is
+    from the triangulated joints.  One view's fit knows the body's shape far
+    better than where it stands along the line of sight (its depth comes
+    from the body's size: 5-15 cm off), so each frame of it is first moved
+    onto the triangulated joints: by the median offset of the joints both
+    have (none: left where it is).  A filled joint's confidence is
     :data:`MONO_WEIGHT` × the monocular fit's.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        Triangulated joints, metres, the floor at z = 0 (NaN where missing).
+    jconf : (T, J) ndarray
+    missing : (T, J) ndarray of bool
+        Joints to fill.
+    mono : FitResult
+    floor : float
+        Metres.
+
+    Returns
+    -------
+    joints : (T, J, 3) ndarray
+    jconf : (T, J) ndarray
     """
-    fill = missing & np.all(np.isfinite(mono.joints), axis=-1)
-    joints = np.where(fill[..., None], np.asarray(mono.joints) - np.array([0.0, 0.0, floor]), joints)
+    joints = np.asarray(joints, float)
+    mj = np.asarray(mono.joints, float) - np.array([0.0, 0.0, floor])
+    both = (np.asarray(jconf) > 0) & np.all(np.isfinite(mj), axis=-1) & np.all(np.isfinite(joints), axis=-1)
+    offset = np.zeros((len(mj), 3))
+    for t in np.flatnonzero(both.any(axis=1)):
+        offset[t] = np.median(joints[t, both[t]] - mj[t, both[t]], axis=0)
+    mj = mj + offset[:, None]
+    fill = missing & np.all(np.isfinite(mj), axis=-1)
+    joints = np.where(fill[..., None], mj, joints)
     return joints, np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
 
 

@@ -1,0 +1,59 @@
+"""Joints no two cameras saw, filled from one view's fit (:mod:`capture2notation.fitting.multiview`)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from capture2notation.body import JOINTS, Body, joint_index
+from capture2notation.fitting.multiview import MONO_WEIGHT, fill_view, filled
+
+#: Metres: a one-view fit's error along its line of sight (its depth comes
+#: from the body's size), the case the fill must not carry over.
+DEPTH_ERROR_M = 0.12
+
+
+def _standing(T: int, rng: np.random.Generator) -> np.ndarray:
+    return np.repeat(Body().rest[None], T, axis=0) + rng.normal(0.0, 0.003, (T, len(JOINTS), 3))
+
+
+def test_a_monocular_fill_lands_on_the_triangulated_body_not_at_its_own_depth():
+    rng = np.random.default_rng(3)
+    T = 20
+    truth = _standing(T, rng)
+    left_arm = [joint_index(n) for n in ("left_shoulder", "left_elbow", "left_wrist", "left_hand_tip")]
+    joints, jconf = truth.copy(), np.ones((T, len(JOINTS)))
+    joints[:, left_arm], jconf[:, left_arm] = np.nan, 0.0  # the side camera cannot see the far arm
+    missing = jconf == 0
+    # The front camera's own fit: the right shape, 12 cm too far away, and
+    # above the floor by the `floor` the triangulated joints were moved by.
+    floor = 0.05
+    mono = SimpleNamespace(
+        joints=truth + np.array([0.0, DEPTH_ERROR_M, floor]) + rng.normal(0.0, 0.005, truth.shape),
+        confidence=np.full((T, len(JOINTS)), 0.9),
+    )
+    out, conf = filled(joints, jconf, missing, mono, floor)
+    err = np.linalg.norm(out[:, left_arm] - truth[:, left_arm], axis=-1)
+    # The shape's own noise (5 mm per coordinate), not the fit's depth.
+    assert np.median(err) < 0.015 and err.max() < 0.03
+    np.testing.assert_array_equal(out[~missing], joints[~missing])
+    np.testing.assert_allclose(conf[missing], MONO_WEIGHT * 0.9)
+
+
+def test_a_frame_with_nothing_triangulated_keeps_the_monocular_fit():
+    rng = np.random.default_rng(4)
+    truth = _standing(3, rng)
+    joints, jconf = np.full_like(truth, np.nan), np.zeros(truth.shape[:2])
+    mono = SimpleNamespace(joints=truth + 0.1, confidence=np.ones(truth.shape[:2]))
+    out, _ = filled(joints, jconf, jconf == 0, mono, 0.0)
+    np.testing.assert_allclose(out, truth + 0.1)
+
+
+def test_the_fill_comes_from_the_view_that_sees_the_missing_joints():
+    T = 5
+    missing = np.zeros((T, len(JOINTS)), bool)
+    missing[:, joint_index("left_wrist")] = True
+    front, side = np.ones((T, 33)), np.ones((T, 33))
+    side[:, 15] = 0.0  # BlazePose's left wrist, hidden from the side
+    assert fill_view([side, front], missing) == 1
