@@ -2,13 +2,17 @@
 
 Three measurements (each prints its table; nothing is asserted):
 
-``--video SECONDS`` (default 60)
+``--video SECONDS`` (default 60) ``[--cameras front,side]``
     A random score of that length performed by the virtual dancer,
     rendered at 25 fps 640×480 (front), captured from the video alone as
     ``c2n capture`` does it (BlazePose, camera estimated, tempo given,
     Effort with ``--workers``), in a fresh process: wall time per stage, the
     ratio to the clip's duration and the peak resident memory of the
-    capture process and of its largest Effort worker.
+    capture process and of its largest Effort worker.  With ``--cameras``
+    the same performance is rendered from each view and captured from all
+    of them at once, the renders' cameras given as ``--calibration`` (for
+    speed only: ``bench_multiview.py`` measures accuracy with calibrations
+    from board clips).
 
 ``--minutes 10 20 40 60``
     Long clips without pixels: random one-minute phrases performed back to
@@ -126,7 +130,7 @@ def run_capture(args: list, workdir: Path) -> dict:
     return out
 
 
-def bench_video(seconds: float, workers: int, workdir: Path) -> None:
+def bench_video(seconds: float, workers: int, workdir: Path, cameras: tuple[str, ...] = ()) -> None:
     from capture2notation.notation import write
     from synthetic.render import render_score
 
@@ -134,11 +138,20 @@ def bench_video(seconds: float, workers: int, workdir: Path) -> None:
     cut = Fraction(round(seconds * TEMPO / 60))
     score = score.replace(symbols=tuple(s for s in score.symbols if s.end <= cut))
     write(score, workdir / "video_score.lab")
-    video = render_score(score, workdir / "video_render", progress=False) / "video.mp4"
     out = workdir / "video_capture"
-    m = run_capture([video, "-o", out, "--tempo", TEMPO, "--workers", workers], workdir)
+    if cameras:
+        from bench_multiview import merged_calibration
+
+        renders = {v: render_score(score, workdir / "video_render" / v, view=v, progress=False) for v in cameras}
+        calibration = merged_calibration(renders, workdir / "video_render" / "cameras.toml")
+        inputs = [renders[v] / "video.mp4" for v in cameras] + ["--calibration", calibration]
+        seen = f"{' + '.join(cameras)} (the renders' cameras given)"
+    else:
+        inputs = [render_score(score, workdir / "video_render", progress=False) / "video.mp4"]
+        seen = "front, camera estimated"
+    m = run_capture([*inputs, "-o", out, "--tempo", TEMPO, "--workers", workers], workdir)
     duration = len(np.load(out / "capture.npz")["times"]) / 25.0
-    print(f"\n## {duration:.0f}-s render, 640×480 25 fps, captured from the video with Effort ({workers} workers)\n")
+    print(f"\n## {duration:.0f}-s render, 640×480 25 fps, {seen}, captured with Effort ({workers} workers)\n")
     print("| wall s | × clip | CPU s | peak RSS (capture) | largest worker |")
     print("|---|---|---|---|---|")
     print(
@@ -216,6 +229,9 @@ def bench_spans(workdir: Path) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--video", type=float, default=None, metavar="SECONDS", help="render and capture a clip this long")
+    ap.add_argument(
+        "--cameras", default="", metavar="V,V", help="with --video: capture these views together, e.g. front,side"
+    )
     ap.add_argument("--minutes", type=float, nargs="*", default=[], help="keypoint-track clip lengths, minutes")
     ap.add_argument("--effort", action="store_true", help="--minutes with Effort (about 0.06 CPU s a movement)")
     ap.add_argument("--spans", action="store_true", help="held-out phrases fitted whole and in spans")
@@ -228,7 +244,7 @@ def main() -> None:
         workdir = (a.workdir or Path(tmp)).resolve()
         workdir.mkdir(parents=True, exist_ok=True)
         if a.video:
-            bench_video(a.video, a.workers, workdir)
+            bench_video(a.video, a.workers, workdir, tuple(v for v in a.cameras.split(",") if v))
         if a.minutes:
             bench_minutes(a.minutes, a.effort, a.workers, workdir)
         if a.spans:
