@@ -46,6 +46,7 @@ import logging
 import os
 import shutil
 import tempfile
+import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -579,15 +580,20 @@ def notate(
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
     log.info("capture: tempo %s bpm%s", seg.tempo, how)
-    # Exit order: the overlay's thread is joined before the staging folder is moved or removed.
-    with _staging(outdir) as stage, concurrent.futures.ThreadPoolExecutor(max_workers=1) as side:
+    # Exit order: an error stops the overlay, whose thread is then joined
+    # before the staging folder is moved or removed.
+    with (
+        _staging(outdir) as stage,
+        concurrent.futures.ThreadPoolExecutor(max_workers=1) as side,
+        _stopped_on_error() as stop,
+    ):
         # The overlay (decode, draw, encode; OpenCV releases the GIL) is
         # written beside the notation files and Effort, not after them.
         drawing = None
         if kind == "video" and overlay and track is not None:
             from capture2notation.keypoints.overlay import write_overlay
 
-            drawing = side.submit(write_overlay, input_path, track, stage / "overlay.mp4", fps=track.fps)
+            drawing = side.submit(write_overlay, input_path, track, stage / "overlay.mp4", fps=track.fps, stop=stop)
         t0 = time.perf_counter()
         files, skipped = _write_outputs(stage, seg, motion, track, kind, (estimate, camera_source))
         seconds["outputs"] = time.perf_counter() - t0
@@ -612,6 +618,17 @@ def notate(
         files["index.html"] = write_text(stage / "index.html", index_html(staged))
         files = {name: outdir / Path(p).relative_to(stage) for name, p in files.items()}
     return replace(staged, files=files)
+
+
+@contextmanager
+def _stopped_on_error():
+    """A ``threading.Event`` set if the block raises (an error or Ctrl-C): background work watching it gives up."""
+    stop = threading.Event()
+    try:
+        yield stop
+    except BaseException:
+        stop.set()
+        raise
 
 
 @contextmanager

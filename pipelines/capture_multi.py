@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import shutil
 import tempfile
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -224,6 +225,7 @@ class ViewFiles:
         self._tracks = dict(zip(names, tracks))
         self._pool = self._scratch = None
         self._drawings = {}
+        self._stop = threading.Event()
         if overlay:
             from capture2notation.keypoints.overlay import write_overlay
 
@@ -231,7 +233,7 @@ class ViewFiles:
             self._pool = ThreadPoolExecutor(max_workers=1)
             self._drawings = {
                 name: self._pool.submit(
-                    write_overlay, video, track, self._scratch / f"overlay_{name}.mp4", fps=track.fps
+                    write_overlay, video, track, self._scratch / f"overlay_{name}.mp4", fps=track.fps, stop=self._stop
                 )
                 for name, video, track in zip(names, videos, tracks)
             }
@@ -244,7 +246,8 @@ class ViewFiles:
         return files
 
     def close(self) -> None:
-        """Stop drawing (a view already started is finished) and remove the scratch folder."""
+        """Stop drawing (within a frame) and remove the scratch folder."""
+        self._stop.set()
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None

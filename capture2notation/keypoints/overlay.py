@@ -64,17 +64,30 @@ def draw_skeleton(image: np.ndarray, xy: np.ndarray, visibility: np.ndarray, min
     return out
 
 
-def write_overlay(video, track: KeypointTrack, out, fps: float | None = None) -> Path:
+def write_overlay(video, track: KeypointTrack, out, fps: float | None = None, stop=None) -> Path:
     """Write `video` with `track` drawn on it to `out` (atomically).
+
+    Parameters
+    ----------
+    video : str or Path
+    track : KeypointTrack
+    out : str or Path
+    fps : float, optional
+        The frame rate the track was made at, if not the video's.
+    stop : threading.Event, optional
+        Set from another thread to give up (an interrupted capture): no
+        file is left at `out`.
 
     Raises
     ------
     KeypointError
-        The track and the video differ in frame size.
+        The track and the video differ in frame size, or `stop` was set.
     """
     w, h = (int(v) for v in track.image_size)
     with VideoWriter(out, track.fps, (w, h)) as writer:
         for frame in iter_frames(video, fps=fps, stop=len(track)):
+            if stop is not None and stop.is_set():
+                raise KeypointError(f"{out}: overlay stopped at frame {frame.index}")
             if frame.image.shape[:2] != (h, w):
                 raise KeypointError(
                     f"{video}: frame {frame.index} is {frame.image.shape[1]}x{frame.image.shape[0]}, "

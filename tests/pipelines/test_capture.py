@@ -529,7 +529,7 @@ def test_an_overlay_that_fails_beside_the_notation_fails_the_capture_and_leaves_
     from capture2notation.errors import KeypointError
     from capture2notation.keypoints import overlay
 
-    def broken(video, track, out, fps=None):
+    def broken(video, track, out, fps=None, stop=None):
         raise KeypointError(f"{video}: frame 3 is 10x10, the track was made on 640x480")
 
     monkeypatch.setattr(overlay, "write_overlay", broken)

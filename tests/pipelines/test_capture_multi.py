@@ -139,6 +139,35 @@ def test_a_failed_fit_leaves_no_overlays_drawn_beside_it(two_views, tmp_path, mo
     assert not (tmp_path / "out").exists()
 
 
+def test_closing_the_view_files_stops_an_overlay_being_drawn(tmp_path, monkeypatch):
+    # Ctrl-C during a long fit: the overlays drawn beside it give up within
+    # a frame instead of decoding the rest of an hour's clip.
+    import importlib
+    import threading
+
+    from capture2notation.io.video import Frame
+    from capture2notation.keypoints import KeypointTrack
+    from pipelines.capture_multi import ViewFiles
+
+    overlay = importlib.import_module("capture2notation.keypoints.overlay")
+    n, drawn, started = 100_000, [], threading.Event()
+
+    def frames(video, fps=None, stop=None):
+        for i in range(n):
+            drawn.append(i)
+            started.set()
+            yield Frame(i, i / 25.0, np.zeros((48, 64, 3), np.uint8))
+
+    monkeypatch.setattr(overlay, "iter_frames", frames)
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
+    track = KeypointTrack.empty(n, 25.0, (64, 48), backend="markers")
+    views = ViewFiles(["front", "side"], [tmp_path / "a.mp4", tmp_path / "b.mp4"], [track, track], overlay=True)
+    started.wait()
+    views.close()
+    assert len(drawn) < n // 10
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_spine_is_placed_by_the_fit_not_by_one_views_guess(two_views, tmp_path, monkeypatch):
     """Exact keypoints from both views: every landmark joint is triangulated, and the
     waist and chest, which no landmark measures, come out where the dancer's are
