@@ -180,26 +180,28 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     return filled(joints, jconf, missing, mono, floor)
 
 
-def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int):
+def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int, frames: int | None = None):
+    """Each clip's keypoints, the clips on `workers` threads; `frames` (their total) sizes the shared progress."""
     from capture2notation.keypoints import extract
+    from capture2notation.progress import progress as progress_bar
 
     # onnxruntime releases the GIL: a thread per view, one intra-op thread each.
     threads = 1 if workers > 1 else 2
+    desc = f"keypoints ({backend}, {len(videos)} clips)"
+    with progress_bar(total=frames or None, unit="frame", desc=desc, enabled=progress) as bar:
+        lock = threading.Lock()
 
-    def one(v):
-        return extract(
-            v,
-            backend=backend,
-            fps=fps_override,
-            progress=progress and workers == 1,
-            flip_test=flip_test,
-            threads=threads,
-        )
+        def step(_index: int) -> None:
+            with lock:  # one bar counts every clip's frames
+                bar.update(1)
 
-    if workers <= 1:
-        return [one(v) for v in videos]
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(one, videos))
+        def one(v):
+            return extract(v, backend=backend, fps=fps_override, progress=step, flip_test=flip_test, threads=threads)
+
+        if workers <= 1:
+            return [one(v) for v in videos]
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            return list(pool.map(one, videos))
 
 
 class ViewFiles:
@@ -313,7 +315,7 @@ def load_views(
         _align([_Frames(c) for c in counts], [0.0] * len(counts), videos, 1.0)
     seconds: dict = {}
     t0 = time.perf_counter()
-    tracks = _keypoints(videos, backend, fps_override, progress, flip_test, max(1, int(workers)))
+    tracks = _keypoints(videos, backend, fps_override, progress, flip_test, max(1, int(workers)), sum(counts))
     seconds["keypoints"] = time.perf_counter() - t0
     fps = float(tracks[0].fps)
     if offs is None:

@@ -162,7 +162,7 @@ def extract(
     smooth: bool = True,
     markers=None,
     estimator=None,
-    progress: bool = False,
+    progress=False,
     flip_test: bool | None = None,
     identity: bool = True,
 ) -> KeypointTrack:
@@ -181,8 +181,10 @@ def extract(
         Frame range ``[start, stop)``.
     threads, smooth, markers, estimator, flip_test, identity
         As :func:`extract_frames`.
-    progress : bool
-        Show progress on stderr (a bar on a terminal, else a line every 30 s).
+    progress : bool or callable
+        True: show progress on stderr (a bar on a terminal, else a line every
+        30 s); a callable is called with each processed frame's index
+        instead (e.g. one bar shared by several clips).
 
     Returns
     -------
@@ -190,10 +192,11 @@ def extract(
     """
     info = probe(video, fps=fps)
     frames = iter_frames(video, fps=fps, start=start, stop=stop)
-    if not progress:
+    if not progress or callable(progress):
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
-            markers=markers, estimator=estimator, flip_test=flip_test, identity=identity,
+            markers=markers, estimator=estimator, progress=progress or None, flip_test=flip_test,
+            identity=identity,
         )  # fmt: skip
     from ..progress import progress as progress_bar
 

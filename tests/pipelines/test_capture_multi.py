@@ -168,6 +168,18 @@ def test_closing_the_view_files_stops_an_overlay_being_drawn(tmp_path, monkeypat
     assert list(tmp_path.iterdir()) == []
 
 
+def test_the_keypoints_of_every_view_show_one_progress(two_views, tmp_path, capsys):
+    # The views run on threads side by side; one count covers them all
+    # (a line in a log, a bar on a terminal).
+    _, root = two_views
+    capture(
+        [root / v / "video.mp4" for v in VIEWS], tmp_path / "out", backend="markers", tempo=60,
+        calibration=root / "cameras.toml", progress=True, effort=False, overlay=False,
+    )  # fmt: skip
+    n = read_truth(root / "front" / "truth.npz").n_frames
+    assert f"keypoints (markers, 2 clips): {2 * n}/{2 * n} frames (100 %)" in capsys.readouterr().err
+
+
 def test_the_spine_is_placed_by_the_fit_not_by_one_views_guess(two_views, tmp_path, monkeypatch):
     """Exact keypoints from both views: every landmark joint is triangulated, and the
     waist and chest, which no landmark measures, come out where the dancer's are
