@@ -153,31 +153,40 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     `floor` is the height subtracted from the triangulated joints, metres
     (the monocular fit is in the calibration's world, so it is shifted alike).
     """
-    from dataclasses import replace
+    from types import SimpleNamespace
 
     from capture2notation.fitting import Camera, fit_track
     from capture2notation.fitting.camera import undistort_track
-    from capture2notation.fitting.multiview import fill_view, filled
+    from capture2notation.fitting.multiview import fill_view, fill_windows, filled
     from capture2notation.io.calibration import read_calibration
 
     best = fill_view([t.visibility[s] for t, s in zip(tracks, spans)], missing)
     track, span = tracks[best], spans[best]
-    cut = replace(
-        track,
-        times=track.times[span],
-        xy=track.xy[span],
-        visibility=track.visibility[span],
-        presence=track.presence[span],
-        world=track.world[span],
-        crops=track.crops[span],
-        identity_confidence=np.asarray(track.identity_confidence)[span],
-    )
     known = read_calibration(calibration)
-    cut = undistort_track(cut, known, videos[best])
     camera = Camera.from_calibration(known, videos[best], track.image_size, undistorted=True)
-    mono = fit_track(cut, camera=camera)
+    mono = SimpleNamespace(joints=np.full(np.shape(joints), np.nan), confidence=np.zeros(np.shape(jconf)))
+    for w in fill_windows(missing, float(track.fps)):
+        part = _frames(track, slice(span.start + w.start, span.start + w.stop))
+        fit = fit_track(undistort_track(part, known, videos[best]), camera=camera)
+        mono.joints[w], mono.confidence[w] = fit.joints, fit.confidence
     log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
     return filled(joints, jconf, missing, mono, floor)
+
+
+def _frames(track, frames: slice):
+    """`track` cut to `frames`."""
+    from dataclasses import replace
+
+    return replace(
+        track,
+        times=track.times[frames],
+        xy=track.xy[frames],
+        visibility=track.visibility[frames],
+        presence=track.presence[frames],
+        world=track.world[frames],
+        crops=track.crops[frames],
+        identity_confidence=np.asarray(track.identity_confidence)[frames],
+    )
 
 
 def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int, frames: int | None = None):

@@ -30,7 +30,7 @@ from .triangulate import (
     undistorted_pixels,
 )
 
-__all__ = ["MONO_WEIGHT", "fill_view", "filled", "fit_views"]
+__all__ = ["FILL_CONTEXT_S", "MONO_WEIGHT", "fill_view", "fill_windows", "filled", "fit_views"]
 
 log = logging.getLogger(__name__)
 
@@ -38,6 +38,13 @@ log = logging.getLogger(__name__)
 #: views do not see it: depth from one view is the weak direction, so the
 #: fit's priors and the triangulated neighbours count for more.
 MONO_WEIGHT = 0.3
+
+#: Seconds of motion either side of the frames a monocular fit fills: its
+#: smoothness and depth priors need the motion around them.  Two cameras
+#: rarely both lose a joint (BlazePose places every landmark in every view:
+#: a minute of two-camera video had 4 such frames), so the fit covers those
+#: stretches only, not the clip.
+FILL_CONTEXT_S = 1.0
 
 #: (J,) BlazePose landmark of each joint, -1 for joints no landmark is.
 _LANDMARK_OF = np.array([JOINT_TO_BLAZEPOSE.get(name, -1) for name in JOINTS])
@@ -56,6 +63,37 @@ def fill_view(visibility, missing) -> int:
     has = _LANDMARK_OF >= 0
     seen = [float(np.sum(missing[:, has] * np.nan_to_num(np.asarray(v)[:, _LANDMARK_OF[has]]))) for v in visibility]
     return int(np.argmax(seen))
+
+
+def fill_windows(missing, fps: float) -> list[slice]:
+    """The frame ranges a monocular fit must cover to fill `missing`.
+
+    Each run of frames with a missing joint, widened by
+    :data:`FILL_CONTEXT_S` each side (within the clip); overlapping ranges
+    merged.
+
+    Parameters
+    ----------
+    missing : (T, J) ndarray of bool
+    fps : float
+
+    Returns
+    -------
+    list of slice
+        In frame order, disjoint.
+    """
+    need = np.asarray(missing, bool).any(axis=1)
+    T = need.size
+    pad = int(np.ceil(FILL_CONTEXT_S * fps))
+    edges = np.flatnonzero(np.diff(np.r_[0, need.astype(int), 0]))
+    out: list[slice] = []
+    for a, b in zip(edges[::2], edges[1::2]):
+        lo, hi = max(0, int(a) - pad), min(T, int(b) + pad)
+        if out and lo <= out[-1].stop:
+            out[-1] = slice(out[-1].start, hi)
+        else:
+            out.append(slice(lo, hi))
+    return out
 
 
 def filled(joints, jconf, missing, mono: FitResult, floor: float) -> tuple[np.ndarray, np.ndarray]:
@@ -77,6 +115,8 @@ def filled(joints, jconf, missing, mono: FitResult, floor: float) -> tuple[np.nd
     missing : (T, J) ndarray of bool
         Joints to fill.
     mono : FitResult
+        Or any object with its ``joints`` (T, J, 3) and ``confidence``
+        (T, J): NaN and 0 where it was not fitted.
     floor : float
         Metres.
 

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from capture2notation.body import JOINTS, Body, joint_index
-from capture2notation.fitting.multiview import MONO_WEIGHT, fill_view, filled
+from capture2notation.fitting.multiview import FILL_CONTEXT_S, MONO_WEIGHT, fill_view, fill_windows, filled
 
 #: Metres: a one-view fit's error along its line of sight (its depth comes
 #: from the body's size), the case the fill must not carry over.
@@ -57,3 +57,19 @@ def test_the_fill_comes_from_the_view_that_sees_the_missing_joints():
     front, side = np.ones((T, 33)), np.ones((T, 33))
     side[:, 15] = 0.0  # BlazePose's left wrist, hidden from the side
     assert fill_view([side, front], missing) == 1
+
+
+def test_the_monocular_fit_covers_the_missing_frames_and_a_second_about_them():
+    fps, T = 25.0, 400
+    missing = np.zeros((T, len(JOINTS)), bool)
+    missing[100:104, joint_index("left_wrist")] = True
+    missing[130:131, joint_index("left_elbow")] = True  # within a second of the first run: merged
+    missing[390:, joint_index("right_ankle")] = True  # at the clip's end: clipped
+    pad = int(np.ceil(FILL_CONTEXT_S * fps))
+    assert fill_windows(missing, fps) == [slice(100 - pad, 131 + pad), slice(390 - pad, T)]
+    windows = fill_windows(missing, fps)
+    covered = np.zeros(T, bool)
+    for w in windows:
+        covered[w] = True
+    assert covered[missing.any(axis=1)].all()
+    assert fill_windows(np.zeros((T, len(JOINTS)), bool), fps) == []
