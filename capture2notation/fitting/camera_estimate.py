@@ -25,7 +25,12 @@ Model and noise
   height above the floor (noise :data:`FLOOR_SIGMA_M`, soft-L1 so that
   frames with both feet off the floor count little), and the trunk (mid-hip
   → mid-shoulder) is vertical (noise :data:`AXIS_SIGMA_DEG`: dancers lean).
-  Their spread is the Gauss–Newton covariance ``s² (JᵀJ)⁻¹`` at the solution.
+  Their spread is the larger of the Gauss–Newton covariance ``s² (JᵀJ)⁻¹``
+  at the solution and the same block bootstrap as the focal length's (each
+  resample with its own focal length): the
+  model's own errors (a phrase that leans one way for seconds, a foot that
+  rests off the floor) persist over many frames, which the Gauss–Newton
+  spread, treating every frame as independent, cannot see.
 
 Conventions: pitch is positive when the camera looks up, roll positive when
 it is turned clockwise seen from behind (:func:`pitch_roll`).
@@ -59,7 +64,7 @@ FOCAL_GRID = 193
 #: Focal lengths whose frame costs are computed at once (bounds the working
 #: array to FOCAL_CHUNK × MAX_FRAMES × 33 × 3 floats, 19 MB).
 FOCAL_CHUNK = 40
-#: Bootstrap resamples of frame blocks for the focal length's spread.
+#: Bootstrap resamples of frame blocks for the spreads of the focal length, height, pitch and roll.
 BOOTSTRAP = 24
 #: Frames per bootstrap block (about a second at 25 fps: errors persist that long).
 BLOCK_FRAMES = 25
@@ -300,41 +305,53 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
     rng = np.random.default_rng(seed)
     n_blocks = max(1, len(frames) // BLOCK_FRAMES)
     blocks = np.array_split(np.arange(len(frames)), n_blocks)
-    boot = []
+    boot, picks = [], []
     for _ in range(BOOTSTRAP if n_blocks > 1 else 0):
         pick = np.concatenate([blocks[i] for i in rng.integers(0, n_blocks, n_blocks)])
+        picks.append(pick)
         boot.append(_best_focal(grid, costs @ np.bincount(pick, minlength=len(frames)))[0])
     f_sd = float(np.std(boot, ddof=1)) if len(boot) > 1 else float("nan")
 
-    P = Wf + _translations(f, m)[:, None]
-    feet = P[:, list(_FOOT)]
     feet_seen = seen[frames][:, list(_FOOT)]
-    hips = 0.5 * (P[:, 23] + P[:, 24])
-    trunk = 0.5 * (P[:, 11] + P[:, 12]) - hips
-    trunk /= np.linalg.norm(trunk, axis=-1, keepdims=True)
     sigma_axis = np.radians(AXIS_SIGMA_DEG)
+    moments = m
 
-    def residuals(p):
+    def placed(focal):
+        """The clip's foot points and unit trunk axes, camera axes, for a focal length."""
+        P = Wf + _translations(focal, moments)[:, None]
+        trunk = 0.5 * (P[:, 11] + P[:, 12]) - 0.5 * (P[:, 23] + P[:, 24])
+        return P[:, list(_FOOT)], trunk / np.linalg.norm(trunk, axis=-1, keepdims=True)
+
+    def residuals(p, feet, trunk, rows=slice(None)):
         n = up_vector(p[0], p[1])
-        heights = feet @ n + p[2] - foot_rest  # each foot point's height above its rest height
-        heights = np.where(feet_seen, heights, np.inf)
+        heights = feet[rows] @ n + p[2] - foot_rest  # each foot point's height above its rest height
+        heights = np.where(feet_seen[rows], heights, np.inf)
         lowest = heights.min(1)
-        axis = np.cross(trunk, n)  # sine of the trunk's angle from the vertical
+        axis = np.cross(trunk[rows], n)  # sine of the trunk's angle from the vertical
         return np.concatenate([lowest / FLOOR_SIGMA_M, axis.ravel() / sigma_axis])
 
+    def solve(p0, feet, trunk, rows=slice(None)):
+        return least_squares(
+            residuals, p0, args=(feet, trunk, rows), loss="cauchy", f_scale=1.0, x_scale=[0.1, 0.1, 0.5]
+        )
+
+    feet, trunk = placed(f)
     # Start: a level camera, its height from the lowest foot points along −y.
     h0 = float(np.median(np.nanmax(np.where(feet_seen, feet[..., 1], np.nan), 1)))
-    sol = least_squares(residuals, [0.0, 0.0, h0], loss="cauchy", f_scale=1.0, x_scale=[0.1, 0.1, 0.5])
+    sol = solve([0.0, 0.0, h0], feet, trunk)
     J = sol.jac
-    m, k = J.shape
-    s2 = 2.0 * float(sol.cost) / max(m - k, 1)
+    s2 = 2.0 * float(sol.cost) / max(J.shape[0] - J.shape[1], 1)
     try:
         cov = np.linalg.inv(J.T @ J) * s2
         sd = np.sqrt(np.clip(np.diag(cov), 0, None))
     except np.linalg.LinAlgError:
         sd = np.full(3, np.nan)
+    if len(picks) > 1:
+        # Each resample with its own focal length: the height scales with it.
+        spread = np.std([solve(sol.x, *placed(fb), pick).x for fb, pick in zip(boot, picks)], axis=0, ddof=1)
+        sd = np.fmax(sd, spread)
     pitch, roll, height = (float(v) for v in sol.x)
-    contacts = int(np.sum(np.abs(residuals(sol.x)[: len(frames)]) < 2.0))
+    contacts = int(np.sum(np.abs(residuals(sol.x, feet, trunk)[: len(frames)]) < 2.0))
     return CameraEstimate(
         focal_px=float(f),
         focal_sd_px=f_sd,

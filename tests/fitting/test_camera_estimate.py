@@ -121,3 +121,22 @@ def test_best_focal_refines_between_grid_points(true_f):
     assert inside and f == pytest.approx(true_f, rel=1e-9)
     f, inside = _best_focal(grid, grid)  # decreasing focal: cheapest at the widest lens
     assert not inside and f == grid[0]
+
+
+def test_the_stated_spread_covers_a_clip_whose_halves_disagree():
+    """Model error that persists for seconds (a phrase leaning one way, then
+    the other) is what a frame-by-frame spread cannot see: here the first
+    half is seen by a camera rolled +8°, the second by one rolled −8°.  Each
+    half's own estimate must lie within the clip's stated two sd."""
+    halves = []
+    for roll in (8.0, -8.0):
+        cam = Camera.phone("front", SIZE, 1.7, 1.0, 0.0, roll, 60.0)
+        halves.append(_landmarks(3, cam))
+    T = len(halves[0][0]) // 2
+    clip = [np.concatenate([a[:T], b[T : 2 * T]]) for a, b in zip(*halves)]
+    est = estimate_camera(*clip, SIZE)
+    own = [estimate_camera(*(x[sl] for x in clip), SIZE) for sl in (slice(0, T), slice(T, 2 * T))]
+    assert all(o is not None for o in own) and est is not None
+    assert abs(own[0].roll_deg - own[1].roll_deg) > 10.0  # the halves do disagree
+    for o in own:
+        assert abs(o.roll_deg - est.roll_deg) <= 2 * est.roll_sd_deg
