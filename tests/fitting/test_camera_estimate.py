@@ -140,3 +140,20 @@ def test_the_stated_spread_covers_a_clip_whose_halves_disagree():
     assert abs(own[0].roll_deg - own[1].roll_deg) > 10.0  # the halves do disagree
     for o in own:
         assert abs(o.roll_deg - est.roll_deg) <= 2 * est.roll_sd_deg
+
+
+def test_a_person_without_perspective_leaves_the_field_of_view_to_the_prior():
+    """A body with no depth extent looks the same through every lens at a
+    matching distance: the landmarks cannot tell the focal length, so the
+    estimate is the prior's (the phones people film with), not an end of
+    the searched range."""
+    from capture2notation.fitting.camera_estimate import PRIOR_HFOV_DEG
+
+    cam = Camera.phone("front", SIZE, 1.7, 1.0, 0.0, 0.0, 60.0)
+    xy, vis, world = _landmarks(3, cam, px_noise=0.0, world_noise=0.0)
+    world[..., 2] = 0.0  # flat in depth
+    f0, distance = 600.0, 4.0
+    xy = np.stack([SIZE[0] / 2 + f0 * world[..., 0] / distance, SIZE[1] / 2 + f0 * world[..., 1] / distance], -1)
+    est = estimate_camera(xy, vis, world, SIZE)
+    assert est is not None and est.focal_resolved
+    assert est.hfov_deg == pytest.approx(PRIOR_HFOV_DEG[0], abs=1.0)
