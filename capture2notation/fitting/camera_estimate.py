@@ -334,11 +334,10 @@ def estimate_camera(xy, visibility, world, image_size, body_height: float | None
 
     feet_seen = seen[frames][:, list(_FOOT)]
     sigma_axis = np.radians(AXIS_SIGMA_DEG)
-    moments = m
 
     def placed(focal):
         """The clip's foot points and unit trunk axes, camera axes, for a focal length."""
-        P = Wf + _translations(focal, moments)[:, None]
+        P = Wf + _translations(focal, m)[:, None]
         trunk = 0.5 * (P[:, 11] + P[:, 12]) - 0.5 * (P[:, 23] + P[:, 24])
         return P[:, list(_FOOT)], trunk / np.linalg.norm(trunk, axis=-1, keepdims=True)
 

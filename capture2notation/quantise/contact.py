@@ -161,14 +161,12 @@ def decode_contacts(joints: np.ndarray, fps: float, floor: float = 0.0, seen: np
         seen = np.asarray(seen, bool)
         seen = np.concatenate([seen, np.repeat(seen[-1:], hold, axis=0)]) if T else seen
     n = joints.shape[0]
-    if n == 0:
-        return np.zeros((0, 2), bool)
     lows, mids = foot_points(joints)
+    out = np.zeros((n, 2), bool)
     stay_floor = 1.0 - 1.0 / max(2.0, MEAN_STANCE_S * fps)
     stay_air = 1.0 - 1.0 / max(2.0, MEAN_FLIGHT_S * fps)
     logA = np.log(np.array([[stay_air, 1 - stay_air], [1 - stay_floor, stay_floor]]))
     log0 = np.log(np.array([0.5, 0.5]))
-    out = np.zeros((n, 2), bool)
     for k in range(2):
         h = np.asarray(lows[k], float) - floor
         mid = np.asarray(mids[k], float)
