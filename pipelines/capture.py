@@ -189,8 +189,8 @@ def _with_fps(motion, fps: float):
 
 #: Largest camera roll the fit takes from the estimate, degrees.  Phones on a
 #: tripod or a table are rolled up to about 10°; the estimate reads roll from
-#: the trunk's image direction, so a larger one is more likely a dancer's
-#: lasting side lean than the camera.
+#: the body's balance axis (supporting ankle → hips) across the image, so a
+#: larger one is more likely a dancer's lasting side lean than the camera.
 MAX_ROLL_DEG = 20.0
 #: The roll estimate's own noise, degrees: a dancer's leans across the image
 #: read as roll (level cameras, random scores and held-out phrases, front,

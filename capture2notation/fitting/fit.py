@@ -297,7 +297,7 @@ def fit_keypoints(
         Without `camera`: the default camera's roll about its optical axis,
         degrees (:meth:`Camera.default`; e.g. from
         :func:`~.camera_estimate.estimate_camera`, which reads it from the
-        trunk's image direction to about a degree).
+        body's balance axis across the image to about a degree).
 
     Returns
     -------

@@ -157,3 +157,33 @@ def test_a_person_without_perspective_leaves_the_field_of_view_to_the_prior():
     est = estimate_camera(xy, vis, world, SIZE)
     assert est is not None and est.focal_resolved
     assert est.hfov_deg == pytest.approx(PRIOR_HFOV_DEG[0], abs=1.0)
+
+
+@pytest.mark.parametrize("pitch", [-12.0, 10.0])
+def test_a_chest_held_forward_does_not_tilt_the_camera(pitch):
+    """The vertical is the balance axis (supporting ankle → hips), not the trunk.
+
+    A dancer who bends the chest forward for a whole phrase, standing and
+    stepping: read as a vertical trunk, her lean became the camera's pitch
+    (29° off, the height 1.6-2.8 m off).
+    """
+    from capture2notation.notation.formats import loads
+
+    score = loads(
+        "tempo: 60\n0 1 chest forward high\n1 1 right_support place middle\n2 1 right_arm forward high\n"
+        "3 1 left_support place middle\n4 1 left_arm left middle\n5 1 support place low\n"
+        "6 1 right_arm place low\n7 1 support place middle\n",
+        "lab",
+    )
+    cam = Camera.phone("front", SIZE, 1.7, 1.2, pitch, 4.0, 65.0)
+    rng = np.random.default_rng(0)
+    tf = truth_fields(Pose.from_motion(interpret(score, 25.0, Body())), cam)
+    in_cam = np.asarray(tf["landmarks3d"]) @ cam.R.T
+    world = in_cam - 0.5 * (in_cam[:, 23] + in_cam[:, 24])[:, None]
+    xy = np.asarray(tf["keypoints"]) + rng.normal(0, 1.0, np.shape(tf["keypoints"]))
+    est = estimate_camera(xy, np.ones(xy.shape[:2]), world + rng.normal(0, 0.01, world.shape), SIZE)
+    assert est is not None
+    # Issue 13's targets: pitch and roll 2°; the height twice its 5 cm (as above).
+    assert est.pitch_deg == pytest.approx(pitch, abs=2.0)
+    assert est.roll_deg == pytest.approx(4.0, abs=2.0)
+    assert est.height_m == pytest.approx(1.2, abs=0.10)
