@@ -153,24 +153,24 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     `floor` is the height subtracted from the triangulated joints, metres
     (the monocular fit is in the calibration's world, so it is shifted alike).
     """
-    from types import SimpleNamespace
-
     from capture2notation.fitting import Camera, fit_track
     from capture2notation.fitting.camera import undistort_track
-    from capture2notation.fitting.multiview import fill_view, fill_windows, filled
+    from capture2notation.fitting.multiview import fill_from_view
     from capture2notation.io.calibration import read_calibration
 
-    best = fill_view([t.visibility[s] for t, s in zip(tracks, spans)], missing)
-    track, span = tracks[best], spans[best]
     known = read_calibration(calibration)
-    camera = Camera.from_calibration(known, videos[best], track.image_size, undistorted=True)
-    mono = SimpleNamespace(joints=np.full(np.shape(joints), np.nan), confidence=np.zeros(np.shape(jconf)))
-    for w in fill_windows(missing, float(track.fps)):
-        part = _frames(track, slice(span.start + w.start, span.start + w.stop))
-        fit = fit_track(undistort_track(part, known, videos[best]), camera=camera)
-        mono.joints[w], mono.confidence[w] = fit.joints, fit.confidence
-    log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[best])
-    return filled(joints, jconf, missing, mono, floor)
+
+    def fit_window(view: int, frames: slice):
+        track, span = tracks[view], spans[view]
+        camera = Camera.from_calibration(known, videos[view], track.image_size, undistorted=True)
+        part = _frames(track, slice(span.start + frames.start, span.start + frames.stop))
+        return fit_track(undistort_track(part, known, videos[view]), camera=camera)
+
+    visibility = [t.visibility[s] for t, s in zip(tracks, spans)]
+    fps = float(tracks[0].fps)
+    view, joints, jconf = fill_from_view(joints, jconf, missing, floor, visibility, fps, fit_window)
+    log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[view])
+    return joints, jconf
 
 
 def _frames(track, frames: slice):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -30,7 +31,7 @@ from .triangulate import (
     undistorted_pixels,
 )
 
-__all__ = ["FILL_CONTEXT_S", "MONO_WEIGHT", "fill_view", "fill_windows", "filled", "fit_views"]
+__all__ = ["FILL_CONTEXT_S", "MONO_WEIGHT", "fill_from_view", "fill_view", "fill_windows", "filled", "fit_views"]
 
 log = logging.getLogger(__name__)
 
@@ -135,6 +136,45 @@ def filled(joints, jconf, missing, mono: FitResult, floor: float) -> tuple[np.nd
     fill = missing & np.all(np.isfinite(mj), axis=-1)
     joints = np.where(fill[..., None], mj, joints)
     return joints, np.where(fill, MONO_WEIGHT * np.asarray(mono.confidence), jconf)
+
+
+def fill_from_view(joints, jconf, missing, floor: float, visibility, fps: float, fit_window: Callable):
+    """Fill the `missing` joints from one view's monocular fit over the frames that need it.
+
+    The view is :func:`fill_view`'s; it is fitted over each of
+    :func:`fill_windows`'s ranges (no more: two cameras rarely both lose a
+    joint) and placed on the triangulated joints by :func:`filled`.
+
+    Parameters
+    ----------
+    joints : (T, J, 3) ndarray
+        Triangulated joints, metres, the floor at z = 0 (NaN where missing).
+    jconf : (T, J) ndarray
+    missing : (T, J) ndarray of bool
+    floor : float
+        Metres subtracted from the triangulated joints (the fit is in the cameras' world).
+    visibility : sequence of V (T, 33) ndarrays
+        Each view's landmark visibilities.
+    fps : float
+    fit_window : callable
+        ``fit_window(view, frames) -> FitResult`` (or any object with
+        ``joints`` (n, J, 3) and ``confidence`` (n, J)): that view's
+        monocular fit of the frames of the slice `frames`, in the cameras' world.
+
+    Returns
+    -------
+    view : int
+        The view used.
+    joints : (T, J, 3) ndarray
+    jconf : (T, J) ndarray
+    """
+    view = fill_view(visibility, missing)
+    # NaN and 0 outside the windows: filled() leaves those frames as they are.
+    mono = SimpleNamespace(joints=np.full(np.shape(joints), np.nan), confidence=np.zeros(np.shape(jconf)))
+    for w in fill_windows(missing, fps):
+        fit = fit_window(view, w)
+        mono.joints[w], mono.confidence[w] = fit.joints, fit.confidence
+    return (view, *filled(joints, jconf, missing, mono, floor))
 
 
 def fit_views(

@@ -282,22 +282,23 @@ def _capture_cameras(mode: str, motion, kept, cond: Condition, rng, out, conf):
     if mode == "keypoints":
         from capture2notation.fitting import fit_keypoints
         from capture2notation.fitting.camera import Camera as FitCamera
-        from capture2notation.fitting.multiview import fill_view, filled
+        from capture2notation.fitting.multiview import fill_from_view
         from synthetic.render.scene import Pose
 
         pose = Pose.from_motion(motion)
         uv, vis, world = zip(*(_simulated_landmarks(pose, cam, kept, cond, rng) for cam, _ in cams))
 
+        def fit_window(view: int, w: slice):
+            cam = cams[view][0]
+            return fit_keypoints(
+                uv[view][w], vis[view][w], motion.fps, camera=FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height)),
+                world=world[view][w], times=kept[w] / motion.fps, image_size=(cond.width, cond.height),
+            )  # fmt: skip
+
         def fill(joints, jconf, missing, floor):
             # As a capture does: the joints no two cameras saw, from the
             # monocular fit of the camera that sees most of them.
-            best = fill_view(vis, missing)
-            cam = cams[best][0]
-            mono = fit_keypoints(
-                uv[best], vis[best], motion.fps, camera=FitCamera(cam.K, cam.R, cam.t, (cond.width, cond.height)),
-                world=world[best], times=kept / motion.fps, image_size=(cond.width, cond.height),
-            )  # fmt: skip
-            return filled(joints, jconf, missing, mono, floor)
+            return fill_from_view(joints, jconf, missing, floor, vis, motion.fps, fit_window)[1:]
 
         res, _floor = fit_views(
             np.stack(uv), np.stack(vis), [c for _, c in cams], motion.fps, times=kept / motion.fps, fill=fill

@@ -7,7 +7,14 @@ from types import SimpleNamespace
 import numpy as np
 
 from capture2notation.body import JOINTS, Body, joint_index
-from capture2notation.fitting.multiview import FILL_CONTEXT_S, MONO_WEIGHT, fill_view, fill_windows, filled
+from capture2notation.fitting.multiview import (
+    FILL_CONTEXT_S,
+    MONO_WEIGHT,
+    fill_from_view,
+    fill_view,
+    fill_windows,
+    filled,
+)
 
 #: Metres: a one-view fit's error along its line of sight (its depth comes
 #: from the body's size), the case the fill must not carry over.
@@ -73,3 +80,28 @@ def test_the_monocular_fit_covers_the_missing_frames_and_a_second_about_them():
         covered[w] = True
     assert covered[missing.any(axis=1)].all()
     assert fill_windows(np.zeros((T, len(JOINTS)), bool), fps) == []
+
+
+def test_the_fill_fits_only_the_chosen_view_over_its_windows():
+    rng = np.random.default_rng(5)
+    fps, T = 25.0, 300
+    truth = _standing(T, rng)
+    wrist = joint_index("left_wrist")
+    missing = np.zeros((T, len(JOINTS)), bool)
+    missing[150:153, wrist] = True
+    joints, jconf = truth.copy(), np.ones((T, len(JOINTS)))
+    joints[missing], jconf[missing] = np.nan, 0.0
+    front, side = np.ones((T, 33)), np.ones((T, 33))
+    side[:, 15] = 0.0  # BlazePose's left wrist, hidden from the side
+    calls = []
+
+    def fit_window(view, frames):
+        calls.append((view, frames))
+        return SimpleNamespace(joints=truth[frames], confidence=np.full((frames.stop - frames.start, len(JOINTS)), 0.8))
+
+    view, out, conf = fill_from_view(joints, jconf, missing, 0.0, [side, front], fps, fit_window)
+    assert view == 1
+    assert calls == [(1, w) for w in fill_windows(missing, fps)] and len(calls) == 1
+    np.testing.assert_allclose(out[missing], truth[missing], atol=0.02)
+    np.testing.assert_array_equal(out[~missing], joints[~missing])
+    np.testing.assert_allclose(conf[missing], MONO_WEIGHT * 0.8)
