@@ -16,8 +16,8 @@ error (%), pitch and roll errors (degrees), camera-height error (cm), floor
 error (cm: the estimated floor's height under the dancer's feet, where the
 true floor is z = 0) and the stated 1-sd uncertainties, with how many
 errors fall within 2 of them; then the whole-path symbol agreement (tempo
-given) of the uncalibrated capture and of the calibrated one (``--calibration camera.toml``, the true camera), per clip
-and as means.  Targets (issue 13): focal 5 %, pitch and roll 2°, height
+given) of the uncalibrated capture and of the calibrated one
+(``--calibration camera.toml``, the true camera), per clip and as means.  Targets (issue 13): focal 5 %, pitch and roll 2°, height
 5 cm, floor 2 cm.
 """
 

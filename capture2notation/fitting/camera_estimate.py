@@ -319,8 +319,8 @@ def _base_of_support(uv: np.ndarray, feet_seen: np.ndarray) -> np.ndarray:
     """
     v = np.where(feet_seen, uv[:, list(_FOOT), 1], -np.inf)
     left, right = np.maximum(v[:, 0], v[:, 2]), np.maximum(v[:, 1], v[:, 3])
-    leg_px = np.linalg.norm(uv[:, 23] - uv[:, 27], axis=-1) + np.linalg.norm(uv[:, 24] - uv[:, 28], axis=-1)
-    level = np.abs(left - right) <= LEVEL_FEET_FRACTION * 0.5 * leg_px
+    leg_px = np.mean([np.linalg.norm(uv[:, hip] - uv[:, ankle], axis=-1) for hip, _, ankle in _LEG], axis=0)
+    level = np.abs(left - right) <= LEVEL_FEET_FRACTION * leg_px
     w_left = np.where(level, 0.5, (left > right).astype(float))
     return np.column_stack([w_left, 1.0 - w_left])
 
