@@ -9,7 +9,12 @@ before and after :func:`capture2notation.keypoints.identity.correct_identity`,
 the frames with the right identity, the frames whose facing is right, the
 facing flips away from side views, and the frames marked uncertain.
 
-Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S]``
+With ``--render DIR --renders N``, also N renders (front, 640×480, 25 fps,
+mannequin) of such scores through BlazePose: the frames with the right
+identity as BlazePose read them and after the decoder, scored against the
+renderer's keypoints.
+
+Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S] [--render DIR --renders N]``
 """
 
 from __future__ import annotations
@@ -57,54 +62,67 @@ def flips(facing: np.ndarray, keep: np.ndarray) -> int:
     return int(np.sum(f[1:] != f[:-1]))
 
 
-def rendered(seed: int, outdir, n_beats: int = 16) -> None:
-    """A render of a random score with turns through BlazePose: identity before and after the decoder."""
+def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16) -> None:
+    """Renders of random scores with turns through BlazePose: identity as read and after the decoder.
+
+    Draws from `seed` on; a draw is rendered when its dancer turns its back
+    to the camera for at least 10 frames, until `n_clips` are done.  Prints
+    each clip and the totals: frames with the right identity as BlazePose
+    read them and after :func:`correct_identity`, and decoded facing off
+    side views.
+    """
     from pathlib import Path
 
     from capture2notation.io.truth import read_truth
     from capture2notation.keypoints import extract
     from capture2notation.keypoints.evaluate import left_right_swaps, person_height_px
-    from capture2notation.keypoints.identity import decode_identity
     from synthetic.render.job import render_score
 
-    for s in range(seed, seed + 40):  # the first draw that turns its back to the camera
+    tot = np.zeros(5)
+    s, done = seed, 0
+    while done < n_clips and s < seed + 40 * n_clips:
         score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
         pose = Pose.from_motion(interpret(score, 25.0, Body()))
         camera = Camera.for_view("front", (640, 480), pose.body.height)
         fields = truth_fields(pose, camera)
         facing = facing_camera(fields["front"], camera.R)
-        if (~facing).sum() >= 20:
-            break
-    out = render_score(score, Path(outdir) / f"r{s}", progress=False)
-    truth = read_truth(out / "truth.npz")
-    raw = extract(out / "video.mp4", identity=False)
-    fixed = extract(out / "video.mp4")
-    radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
-    truth_face = np.where(facing, 1, -1)
-    for name, tr in (("as read", raw), ("decoded", fixed)):
-        sw = np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0)
+        s += 1
+        if (~facing).sum() < 10:
+            continue
+        out = render_score(score, Path(outdir) / f"r{s - 1}", progress=False)
+        truth = read_truth(out / "truth.npz")
+        raw = extract(out / "video.mp4", identity=False, progress=False)
+        fixed, res = correct_identity(raw)
+        radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
+        wrong = [np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0) for tr in (raw, fixed)]
+        a = np.radians(fields["front"])
+        fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ camera.R.T
+        off = np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
+        face_ok = (res.facing == np.where(facing, 1, -1))[off]
         print(
-            f"render seed {s} ({len(tr)} frames, {int((~facing).sum())} back to camera) {name}: right identity {1 - sw.mean():.1%}"
+            f"render seed {s - 1} ({len(raw)} frames, {int((~facing).sum())} back to camera): right identity "
+            f"as read {1 - wrong[0].mean():.1%}, decoded {1 - wrong[1].mean():.1%}; decoded facing right "
+            f"{face_ok.mean():.1%} off side views; uncertain {res.uncertain.mean():.1%}"
         )
-    res = decode_identity(raw)
-    a = np.radians(fields["front"])
-    fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ camera.R.T
-    off = np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
-    print(
-        f"render seed {s}: decoded facing right {np.mean((res.facing == truth_face)[off]):.1%} off side views; "
-        f"flips truth {flips(truth_face, off)} decoded {flips(res.facing, off)}; uncertain {res.uncertain.mean():.1%}"
-    )
+        tot += [len(raw), (~wrong[0]).sum(), (~wrong[1]).sum(), face_ok.sum(), off.sum()]
+        done += 1
+    if done:
+        print(
+            f"RENDERS {done} clips, {int(tot[0])} frames: right identity as read {tot[1] / tot[0]:.1%}, "
+            f"decoded {tot[2] / tot[0]:.1%}; decoded facing right (off side views) {tot[3] / tot[4]:.1%}"
+        )
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--clips", type=int, default=6)
     ap.add_argument("--seed", type=int, default=1600)
-    ap.add_argument("--render", metavar="DIR", help="also render one turning clip into DIR and run BlazePose on it")
+    ap.add_argument("--render", metavar="DIR", help="also render turning clips into DIR and run BlazePose on them")
+    ap.add_argument("--renders", type=int, default=1, help="how many clips --render renders (from --seed on)")
     ap.add_argument("--clean", action="store_true", help="no errors put in (false corrections)")
     args = ap.parse_args(argv)
     if args.render:
-        rendered(args.seed, args.render)
+        rendered(args.seed, args.render, args.renders)
     tot = {"n": 0, "before": 0, "after": 0, "face_before": 0, "face_after": 0, "nf": 0, "unc": 0, "unc_wrong": 0}
     for i in range(args.clips):
         seed = args.seed + i

@@ -15,9 +15,10 @@ geometric component (a heavy tail: a long coherent swap is not made
 improbable by its length alone, so the evidence decides).  Evidence:
 
 * **continuity of identity** between consecutive frames: whether the
-  labelled landmarks (image and world, depth included) lie nearer the
-  previous frame's as labelled or mirrored (a swap starting or ending shows
-  as a jump of every limb to its twin's place);
+  labelled landmarks (image and world, depth included) lie nearer their
+  constant-velocity prediction from the two frames before as labelled or
+  mirrored (a swap starting or ending shows as a jump of every limb to its
+  twin's place; a turning body is predicted to keep turning);
 * **image order**: facing the camera, a body's left shoulder and hip appear
   to the right of its right ones in the image; with the back to the camera,
   to the left; a swapped labelling reverses this;
@@ -72,9 +73,10 @@ FLIP_FLOOR_PROB = 1e-8
 #: Shoulder/hip width in the image, in torso lengths, at which a facing flip
 #: is e^-1/2 times as likely as side-on (a body facing the camera is ~0.6 wide).
 SIDE_WIDTH = 0.12
-#: Spread of a landmark's frame-to-frame displacement: torso lengths in the
-#: image, metres in the world landmarks (fast limbs and a quick turn move
-#: ~10 cm a frame at 25 Hz; the pose model jitters most when side-on).
+#: Spread of a landmark's error from its constant-velocity prediction when
+#: the body is still: torso lengths in the image, metres in the world
+#: landmarks (the pose model jitters most when side-on).  A moving
+#: landmark's spread adds its last step in quadrature (:func:`_switch_evidence`).
 STEP_SIGMA_IMAGE = 0.2
 STEP_SIGMA_WORLD_M = 0.12
 #: Bound on one frame pair's continuity evidence, nats (one bad frame of the
@@ -210,25 +212,60 @@ def identity_evidence(track: KeypointTrack) -> IdentityEvidence:
     return IdentityEvidence(valid, order, width, facing, switch, temper)
 
 
+def _predicted(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Constant-velocity prediction of frames 1..T−1 from the two frames before each.
+
+    Parameters
+    ----------
+    a : (T, N, D) ndarray
+        Landmark positions (NaN where missing).
+
+    Returns
+    -------
+    pred : (T−1, N, D) ndarray
+        Predicted positions of frames 1..T−1 (the previous frame where the one
+        before it is missing).
+    step : (T−1, N) ndarray
+        Length of the step each prediction extrapolated (0 where none).
+    """
+    last = a[:-1]
+    v = np.zeros_like(last)
+    v[1:] = a[1:-1] - a[:-2]
+    v = np.nan_to_num(v)
+    return last + v, np.linalg.norm(v, axis=-1)
+
+
 def _switch_evidence(xy: np.ndarray, world: np.ndarray, torso: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """Log-odds per frame that the labels jumped to their twins since the previous frame."""
+    """Log-odds per frame that the labels jumped to their twins since the previous frame.
+
+    Each frame is compared, as labelled and mirrored, with its prediction
+    from the two frames before (constant velocity: a turning body keeps
+    turning, where a still one would have it jump to its mirror image).
+    """
     T = xy.shape[0]
     out = np.zeros(T)
     if T < 2:
         return out
     body = np.unique(SWAP_PAIRS.ravel())
     scale = np.fmax(torso[1:], torso[:-1])[:, None]
+    pred_i, step_i = _predicted(xy)
+    pred_w, step_w = _predicted(world)
     mirrored_xy = xy[1:][:, MIRROR]
-    same_i = np.linalg.norm(xy[1:, body] - xy[:-1, body], axis=-1) / scale
-    cross_i = np.linalg.norm(mirrored_xy[:, body] - xy[:-1, body], axis=-1) / scale
+    same_i = np.linalg.norm(xy[1:, body] - pred_i[:, body], axis=-1) / scale
+    cross_i = np.linalg.norm(mirrored_xy[:, body] - pred_i[:, body], axis=-1) / scale
     w_cur = world[1:]
     w_mir = world[1:][:, MIRROR] * np.array([1.0, 1.0, -1.0])  # the mirror reading reflects depth
-    same_w = np.linalg.norm(w_cur[:, body] - world[:-1, body], axis=-1)
-    cross_w = np.linalg.norm(w_mir[:, body] - world[:-1, body], axis=-1)
-    # Cauchy per landmark: when neither reading fits (a fast spin, a lost
-    # frame) the two costs are alike and the frame pair says little.
-    e_img = np.log1p((same_i / STEP_SIGMA_IMAGE) ** 2) - np.log1p((cross_i / STEP_SIGMA_IMAGE) ** 2)
-    e_world = np.log1p((same_w / STEP_SIGMA_WORLD_M) ** 2) - np.log1p((cross_w / STEP_SIGMA_WORLD_M) ** 2)
+    same_w = np.linalg.norm(w_cur[:, body] - pred_w[:, body], axis=-1)
+    cross_w = np.linalg.norm(w_mir[:, body] - pred_w[:, body], axis=-1)
+    # The prediction's error grows with the step it extrapolates (a turning
+    # body's landmarks move on arcs, not lines): its spread is the still
+    # body's and that step in quadrature, so a fast spin says little.
+    sig_i = np.hypot(STEP_SIGMA_IMAGE, step_i[:, body] / scale)
+    sig_w = np.hypot(STEP_SIGMA_WORLD_M, step_w[:, body])
+    # Cauchy per landmark: when neither reading fits (a lost frame) the two
+    # costs are alike and the frame pair says little.
+    e_img = np.log1p((same_i / sig_i) ** 2) - np.log1p((cross_i / sig_i) ** 2)
+    e_world = np.log1p((same_w / sig_w) ** 2) - np.log1p((cross_w / sig_w) ** 2)
     # Points seen in both frames only; each landmark counts once per source.
     e = np.nansum(np.where(np.isfinite(e_img), e_img, 0.0), axis=1) + np.nansum(
         np.where(np.isfinite(e_world), e_world, 0.0), axis=1
