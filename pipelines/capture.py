@@ -263,6 +263,7 @@ def load_motion(
     if kind in FITTED_KINDS:
         from capture2notation.fitting import Camera, fit_track
         from capture2notation.fitting.camera import undistort_track
+        from capture2notation.fitting.yaw import with_image_yaw
         from capture2notation.keypoints import KeypointTrack, extract
 
         known = None
@@ -292,6 +293,8 @@ def load_motion(
         t0 = time.perf_counter()
         roll = 0.0 if camera is not None else _fit_roll(estimate)
         motion = fit_track(pinhole, camera=camera, roll_deg=roll)
+        # One view's depth cannot say which way a turning body faces; the image can.
+        motion = with_image_yaw(motion, pinhole, camera or Camera.default(track.image_size, roll_deg=roll))
         if floor is not None:
             motion = _lowered(motion, floor)
         seconds["fitting"] = time.perf_counter() - t0

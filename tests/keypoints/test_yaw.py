@@ -1,0 +1,72 @@
+"""The body's yaw towards the camera decoded from the image (:mod:`capture2notation.keypoints.yaw`),
+on the virtual dancer's exact keypoints."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from capture2notation.body import Body
+from capture2notation.keypoints.track import KeypointTrack
+from capture2notation.keypoints.yaw import decode_yaw
+from synthetic.identity_errors import truth_track
+from synthetic.interpret import interpret
+from synthetic.random_scores import random_score
+from synthetic.render.camera import Camera
+from synthetic.render.job import truth_fields
+from synthetic.render.scene import Pose
+
+#: Half an eighth of a turn, degrees: the turn quantiser rounds amounts to eighths.
+HALF_EIGHTH_DEG = 22.5
+
+
+def _clip(seed: int, fps: float = 25.0, turns: bool = True):
+    score = random_score(np.random.default_rng(seed), n_beats=16, turns=turns, fps=fps)
+    pose = Pose.from_motion(interpret(score, fps, Body()))
+    camera = Camera.for_view("front", (640, 480), pose.body.height)
+    fields = truth_fields(pose, camera)
+    a = np.radians(np.asarray(fields["front"], float))
+    forward = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ np.asarray(camera.R).T
+    # Camera axes: x right, z away from the camera; facing it is forward along -z.
+    yaw = np.degrees(np.unwrap(np.arctan2(forward[:, 0], -forward[:, 2])))
+    return truth_track(fields), yaw
+
+
+def _err(a, b):
+    return np.abs((a - b + 180.0) % 360.0 - 180.0)
+
+
+@pytest.mark.parametrize("seed", [500, 503, 504])  # the first draws from 500 that turn half way or more
+def test_turns_are_followed_through_back_views(seed):
+    track, truth = _clip(seed)
+    assert np.ptp(truth) >= 180.0  # the dancer turns at least half way round
+    got = decode_yaw(track)
+    assert np.mean(_err(got, truth) <= HALF_EIGHTH_DEG) >= 0.9
+    # Unwrapped: the whole clip's rotation, turn for turn.
+    assert abs((got[-1] - got[0]) - (truth[-1] - truth[0])) <= HALF_EIGHTH_DEG
+
+
+def test_a_dancer_who_never_turns_faces_the_camera_throughout():
+    for seed in range(40):
+        track, truth = _clip(seed, turns=False)
+        if np.ptp(truth) < 1.0:
+            break
+    got = decode_yaw(track)
+    assert np.mean(_err(got, 0.0) <= HALF_EIGHTH_DEG) >= 0.95
+
+
+def test_a_faster_frame_rate_gives_the_same_yaw():
+    track, truth = _clip(500, fps=50.0)
+    got = decode_yaw(track)
+    assert np.mean(_err(got, truth) <= HALF_EIGHTH_DEG) >= 0.9
+
+
+def test_without_feet_or_person_there_is_no_yaw():
+    track, _ = _clip(500)
+    track.xy[:, 29:33] = np.nan  # no heel or toe landmarks (e.g. colour markers)
+    assert np.all(np.isnan(decode_yaw(track)))
+    track, _ = _clip(500)
+    track.xy[5:9] = np.nan
+    got = decode_yaw(track)
+    assert np.all(np.isnan(got[5:9])) and np.all(np.isfinite(got[9:]))
+    assert decode_yaw(KeypointTrack.empty(0, 25.0, (64, 48), "blazepose")).shape == (0,)
