@@ -79,6 +79,11 @@ SIDE_WIDTH = 0.12
 #: landmark's spread adds its last step in quadrature (:func:`_switch_evidence`).
 STEP_SIGMA_IMAGE = 0.2
 STEP_SIGMA_WORLD_M = 0.12
+#: Longest frame interval over which a landmark's last velocity predicts its
+#: next position, seconds (20 fps and faster): over 0.2 s (5 fps) a limb
+#: stops and starts within a movement, and extrapolating its last step
+#: read profile views of the built-in phrases as swapped.
+VELOCITY_MAX_INTERVAL_S = 0.05
 #: Bound on one frame pair's continuity evidence, nats (one bad frame of the
 #: pose model must not decide a whole stretch on its own).
 CONTINUITY_CAP = 40.0
@@ -208,17 +213,20 @@ def identity_evidence(track: KeypointTrack) -> IdentityEvidence:
     cues = BELIEF_NATS * belief + FOOT_IMAGE_NATS * foot
     temper = float(min(1.0, 1.0 / (track.fps * CUE_CORRELATION_S)))
     facing = np.where(valid, temper * cues, 0.0)
-    switch = _switch_evidence(xy, world, torso, valid)
+    switch = _switch_evidence(xy, world, torso, valid, float(track.fps))
     return IdentityEvidence(valid, order, width, facing, switch, temper)
 
 
-def _predicted(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _predicted(a: np.ndarray, extrapolate: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Constant-velocity prediction of frames 1..T−1 from the two frames before each.
 
     Parameters
     ----------
     a : (T, N, D) ndarray
         Landmark positions (NaN where missing).
+    extrapolate : bool
+        False: predict the previous frame's positions (the step is still
+        returned, to widen the spread).
 
     Returns
     -------
@@ -232,15 +240,17 @@ def _predicted(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     v = np.zeros_like(last)
     v[1:] = a[1:-1] - a[:-2]
     v = np.nan_to_num(v)
-    return last + v, np.linalg.norm(v, axis=-1)
+    return (last + v if extrapolate else last), np.linalg.norm(v, axis=-1)
 
 
-def _switch_evidence(xy: np.ndarray, world: np.ndarray, torso: np.ndarray, valid: np.ndarray) -> np.ndarray:
+def _switch_evidence(xy: np.ndarray, world: np.ndarray, torso: np.ndarray, valid: np.ndarray, fps: float) -> np.ndarray:
     """Log-odds per frame that the labels jumped to their twins since the previous frame.
 
     Each frame is compared, as labelled and mirrored, with its prediction
     from the two frames before (constant velocity: a turning body keeps
-    turning, where a still one would have it jump to its mirror image).
+    turning, where a still one would have it jump to its mirror image);
+    at frame intervals beyond :data:`VELOCITY_MAX_INTERVAL_S`, with the
+    previous frame.
     """
     T = xy.shape[0]
     out = np.zeros(T)
@@ -248,8 +258,9 @@ def _switch_evidence(xy: np.ndarray, world: np.ndarray, torso: np.ndarray, valid
         return out
     body = np.unique(SWAP_PAIRS.ravel())
     scale = np.fmax(torso[1:], torso[:-1])[:, None]
-    pred_i, step_i = _predicted(xy)
-    pred_w, step_w = _predicted(world)
+    extrapolate = 1.0 / fps <= VELOCITY_MAX_INTERVAL_S
+    pred_i, step_i = _predicted(xy, extrapolate)
+    pred_w, step_w = _predicted(world, extrapolate)
     mirrored_xy = xy[1:][:, MIRROR]
     same_i = np.linalg.norm(xy[1:, body] - pred_i[:, body], axis=-1) / scale
     cross_i = np.linalg.norm(mirrored_xy[:, body] - pred_i[:, body], axis=-1) / scale
