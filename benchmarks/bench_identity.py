@@ -50,11 +50,17 @@ def clip(seed: int, n_beats: int = 24, fps: float = 25.0, clean: bool = False):
     start = rng.uniform(0.05 * dur, 0.95 * dur - length)
     swaps = () if clean else ((start, start + length),)
     bad, sim = with_identity_errors(track, facing, rng, swaps=swaps, back_as_front=not clean)
-    # Angle from side-on of the body's front, to leave the side views out of the facing score.
-    a = np.radians(fields["front"])
-    fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ camera.R.T
-    off_side = np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
-    return bad, sim, off_side
+    return bad, sim, off_side_views(fields["front"], camera.R)
+
+
+def off_side_views(front_deg, R) -> np.ndarray:
+    """(T,) bool: the body's front more than :data:`SIDE_BAND_DEG` from side-on to the camera.
+
+    The facing score leaves the side views out: there facing is undefined to within the noise.
+    """
+    a = np.radians(np.asarray(front_deg, float))
+    fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ np.asarray(R).T
+    return np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
 
 
 def flips(facing: np.ndarray, keep: np.ndarray) -> int:
@@ -95,9 +101,7 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16) -> None:
         fixed, res = correct_identity(raw)
         radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
         wrong = [np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0) for tr in (raw, fixed)]
-        a = np.radians(fields["front"])
-        fwd = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ camera.R.T
-        off = np.degrees(np.arcsin(np.clip(np.abs(fwd[:, 2]), 0, 1))) > SIDE_BAND_DEG
+        off = off_side_views(fields["front"], camera.R)
         face_ok = (res.facing == np.where(facing, 1, -1))[off]
         print(
             f"render seed {s - 1} ({len(raw)} frames, {int((~facing).sum())} back to camera): right identity "

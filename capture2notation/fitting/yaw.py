@@ -55,10 +55,8 @@ def front_from_yaw(yaw_deg, R) -> np.ndarray:
     out = np.full(yaw.shape, np.nan)
     ok = np.isfinite(yaw)
     if ok.any():
-        a = np.arctan2(forward[ok, 0], forward[ok, 1])
-        # Unwrapped as the yaw is: the offset of the first frame, then the yaw's own steps.
-        a0 = np.degrees(a[0])
-        out[ok] = a0 + np.degrees(np.unwrap(a) - a[0])
+        # Unwrapped as the yaw is: its steps are far below half a turn.
+        out[ok] = np.degrees(np.unwrap(np.arctan2(forward[ok, 0], forward[ok, 1])))
     return out
 
 

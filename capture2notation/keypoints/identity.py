@@ -50,6 +50,7 @@ __all__ = [
     "correct_identity",
     "decode_identity",
     "identity_evidence",
+    "torso_and_order",
 ]
 
 #: Posterior probability of the decided identity below which a frame is
@@ -181,6 +182,39 @@ def _mean_pair(a: np.ndarray, idx) -> np.ndarray:
     return np.nanmean(a[:, list(idx)], axis=1)
 
 
+def torso_and_order(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The torso's image length and the body's left-minus-right image order in each frame.
+
+    Parameters
+    ----------
+    xy : (T, 33, ≥2) ndarray
+        Image landmarks, pixels (NaN where missing).
+
+    Returns
+    -------
+    torso : (T,) ndarray
+        Shoulders' middle to hips' middle, pixels; NaN where not seen.
+    valid : (T,) bool ndarray
+        Shoulders and hips seen (a torso longer than 1e-6 px).
+    order : (T,) ndarray
+        Left-minus-right x of the shoulders and of the hips, averaged, in
+        torso lengths: positive as a body facing the camera with correct
+        labels; NaN where not seen.
+    """
+    xy = np.asarray(xy, float)
+    with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
+        # Frames without a person average nothing (NaN).
+        warnings.simplefilter("ignore", RuntimeWarning)
+        sh = np.nanmean(xy[:, list(_SHOULDERS), :2], axis=1)
+        hp = np.nanmean(xy[:, list(_HIPS), :2], axis=1)
+        torso = np.linalg.norm(sh - hp, axis=1)
+        valid = np.isfinite(torso) & (torso > 1e-6)
+        torso = np.where(valid, torso, np.nan)
+        dx = np.stack([xy[:, left, 0] - xy[:, right, 0] for left, right in (_SHOULDERS, _HIPS)], axis=1)
+        order = np.nanmean(dx, axis=1) / torso
+    return torso, valid, order
+
+
 def identity_evidence(track: KeypointTrack) -> IdentityEvidence:
     """The decoder's per-frame evidence from a track (see the module docstring)."""
     xy = track.xy[:, :, :2]
@@ -189,13 +223,7 @@ def identity_evidence(track: KeypointTrack) -> IdentityEvidence:
     with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
         # Frames without a person average nothing (NaN): they are marked invalid below.
         warnings.simplefilter("ignore", RuntimeWarning)
-        sh = np.nanmean(xy[:, list(_SHOULDERS)], axis=1)
-        hp = np.nanmean(xy[:, list(_HIPS)], axis=1)
-        torso = np.linalg.norm(sh - hp, axis=1)
-        valid = np.isfinite(torso) & (torso > 1e-6)
-        torso = np.where(valid, torso, np.nan)
-        dx = np.stack([xy[:, left, 0] - xy[:, right, 0] for left, right in (_SHOULDERS, _HIPS)], axis=1)
-        order = np.nanmean(dx, axis=1) / torso
+        torso, valid, order = torso_and_order(xy)
         width = np.abs(order)
         order = np.where(valid & np.isfinite(order), order, 0.0)
         width = np.where(valid & np.isfinite(width), width, 0.0)

@@ -27,6 +27,7 @@ import warnings
 
 import numpy as np
 
+from .identity import torso_and_order
 from .track import KeypointTrack
 
 __all__ = [
@@ -71,21 +72,17 @@ MIN_FEET_SEEN = 0.5
 FEET_SIDE_ON = 0.41
 WIDTH_FACING = 0.55
 
-_SHOULDERS, _HIPS = (11, 12), (23, 24)
 _HEELS, _TOES = (29, 30), (31, 32)
 
 
 def _cues(track: KeypointTrack) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-frame feet (∝ sin θ) and width (∝ cos θ) cues in units of their full values, and the frames seen."""
     xy = np.asarray(track.xy, float)[:, :, :2]
-    with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
-        # Frames without a person average nothing (NaN): they carry no cue.
+    torso, seen, width = torso_and_order(xy)
+    with warnings.catch_warnings():
+        # Frames without feet average nothing (NaN): they carry no cue.
         warnings.simplefilter("ignore", RuntimeWarning)
-        torso = np.linalg.norm(np.nanmean(xy[:, list(_SHOULDERS)], 1) - np.nanmean(xy[:, list(_HIPS)], 1), axis=1)
-        seen = np.isfinite(torso) & (torso > 1e-6)
-        torso = np.where(seen, torso, np.nan)
         feet = np.nanmean(xy[:, list(_TOES), 0] - xy[:, list(_HEELS), 0], axis=1) / torso
-        width = np.nanmean(np.stack([xy[:, a, 0] - xy[:, b, 0] for a, b in (_SHOULDERS, _HIPS)], 1), axis=1) / torso
     return feet / FEET_SIDE_ON, width / WIDTH_FACING, seen
 
 
