@@ -578,8 +578,8 @@ def notate(
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
-    conf = getattr(motion, "confidence", None)
-    seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf, line_of_sight=line_of_sight))
+    conf, readings = getattr(motion, "confidence", None), getattr(motion, "front_readings", None)
+    seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf, line_of_sight, readings))
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
     log.info("capture: tempo %s bpm%s", seg.tempo, how)

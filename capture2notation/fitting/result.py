@@ -37,6 +37,13 @@ class FitResult:
         Per-clip offsets of each joint from its parent, metres:
         ``forward_kinematics`` with these offsets reproduces `joints` exactly
         (``Body(height)`` proportions reproduce them approximately).
+    front_readings : (T, 2) ndarray or None
+        Where the front was decoded from one view's image
+        (:func:`~capture2notation.fitting.yaw.with_image_yaw`): each frame's
+        posterior probability of the front as decoded and of its mirror
+        image, the reading the image cannot tell from it, turning the other
+        way (:func:`~capture2notation.keypoints.yaw.decode_yaw_readings`;
+        NaN where unknown); None otherwise.
     """
 
     fps: float
@@ -46,11 +53,14 @@ class FitResult:
     root: np.ndarray
     confidence: np.ndarray
     offsets: np.ndarray | None = None
+    front_readings: np.ndarray | None = None
 
     def __post_init__(self):
         T = np.shape(self.times)[0] if np.ndim(self.times) == 1 else -1
         J = len(JOINTS)
         expect = {"joints": (T, J, 3), "angles": (T, J, 3), "root": (T, 3), "confidence": (T, J)}
+        if self.front_readings is not None:
+            expect["front_readings"] = (T, 2)
         for name, shape in expect.items():
             if np.shape(getattr(self, name)) != shape:
                 raise FittingError(

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..body import body_frame, euler_to_matrix, front_of, joint_index, matrix_to_euler
 from ..errors import FittingError
-from ..keypoints.yaw import decode_yaw
+from ..keypoints.yaw import decode_yaw_readings
 from .camera import Camera
 from .result import FitResult
 
@@ -107,5 +107,11 @@ def with_image_yaw(result: FitResult, track, camera: Camera) -> FitResult:
         Its keypoints, left and right decided.
     camera : Camera
         The camera the fit used (:meth:`Camera.default` for an unknown one).
+
+    Returns
+    -------
+    FitResult
+        Turned (:func:`turned_to`), with ``front_readings`` from the decoder.
     """
-    return turned_to(result, front_from_yaw(decode_yaw(track), camera.R))
+    yaw, readings = decode_yaw_readings(track)
+    return turned_to(result, front_from_yaw(yaw, camera.R)).replace(front_readings=readings)

@@ -12,13 +12,29 @@ depth (the yaw θ, 0 facing the camera, +90° facing the image's right):
 * **the shoulders and hips**: their left-minus-right image offset along x is
   ∝ cos θ (labels as corrected by :mod:`.identity`).
 
-:func:`decode_yaw` decodes θ over the clip by Viterbi on a grid of yaw
-(:data:`YAW_STEP_DEG`) × yaw rate (up to :data:`MAX_RATE_DEG_S`): the rate
-changes smoothly (:data:`RATE_CHANGE_SD_DEG_S2`), so a pirouette keeps
-turning through its side views, where the cues alone would let it turn
-back.  Each cue is Gaussian about its expected value with a share of
-outliers (:data:`CUE_OUTLIER_RATE`), in units of its value side-on or
-facing the camera (:data:`FEET_SIDE_ON`, :data:`WIDTH_FACING`).
+The feet alone cannot tell a turn from its mirror image (θ and 180° − θ
+give the same sin θ, turning the other way), so the direction of a turn
+rests on the shoulders' and hips' order, and that is only as right as the
+left/right labels: where the identity decoder left them swapped, the order
+cue is mirrored for a stretch (on development renders, 13.5 % of the
+frames away from side views, in stretches of 1.3 s frame-weighted mean).
+
+:func:`decode_yaw` models that directly.  The hidden state is yaw
+(:data:`YAW_STEP_DEG` grid) × yaw rate (up to :data:`MAX_RATE_DEG_S`,
+changing smoothly, :data:`RATE_CHANGE_SD_DEG_S2`, so a pirouette keeps
+turning through its side views) × whether the order cue is mirrored (a
+sticky chain: :data:`MIRRORED_SHARE` of the time, in stretches of
+:data:`MIRRORED_MEAN_S`).  Each cue is Gaussian about its expected value
+with a share of outliers (:data:`CUE_OUTLIER_RATE`), in units of its value
+side-on or facing the camera (:data:`FEET_SIDE_ON`, :data:`WIDTH_FACING`).
+Forward–backward gives each frame's posterior over yaw and rate, the
+mirrored stretches summed out; the yaw is then the path through the same
+lattice that is most probable frame by frame under that posterior
+(posterior decoding, which weighs every reading of a stretch rather than
+committing to the single best one, as a Viterbi path over the joint state
+does).  Long clips are decoded in windows of :data:`WINDOW_S` with
+:data:`MARGIN_S` of context on each side, so memory does not grow with
+the clip.
 """
 
 from __future__ import annotations
@@ -35,12 +51,18 @@ __all__ = [
     "CUE_SD",
     "DECODE_FPS",
     "FEET_SIDE_ON",
+    "MARGIN_S",
     "MAX_RATE_DEG_S",
     "MIN_FEET_SEEN",
+    "MIRRORED_MEAN_S",
+    "MIRRORED_SHARE",
     "RATE_CHANGE_SD_DEG_S2",
+    "READING_HALF_WIDTH_DEG",
     "WIDTH_FACING",
+    "WINDOW_S",
     "YAW_STEP_DEG",
     "decode_yaw",
+    "decode_yaw_readings",
 ]
 
 #: Resolution of the yaw grid, degrees (an eighth of a turn is 9 steps).
@@ -58,8 +80,14 @@ DECODE_FPS = 25.0
 #: Spread of each cue about its expected value, in units of its full value.
 CUE_SD = 0.35
 #: Share of frames whose cue is unrelated to the yaw (a foot lifted and
-#: pointed, a swapped label the identity decoder missed).
+#: pointed, a label glitch of a frame or two).
 CUE_OUTLIER_RATE = 0.05
+#: Share of the time the shoulders' and hips' order cue is mirrored (labels
+#: left swapped by the identity decoder), and the mean length of such a
+#: stretch, seconds: 13.5 % of frames and 1.3 s on development renders
+#: (BlazePose, turning random scores; module docstring).
+MIRRORED_SHARE = 0.15
+MIRRORED_MEAN_S = 1.3
 #: Share of the frames with a person that must show the feet: with fewer the
 #: yaw's side (left or right of the camera) is unknown and none is decoded.
 MIN_FEET_SEEN = 0.5
@@ -71,6 +99,10 @@ MIN_FEET_SEEN = 0.5
 #: per clip: a dancer who never turns side-on has no side-on feet to scale by.
 FEET_SIDE_ON = 0.41
 WIDTH_FACING = 0.55
+#: Frames are decoded in windows of this many seconds, each with this much
+#: context either side (a turn's evidence reaches a few seconds at most).
+WINDOW_S = 60.0
+MARGIN_S = 10.0
 
 _HEELS, _TOES = (29, 30), (31, 32)
 
@@ -86,50 +118,164 @@ def _cues(track: KeypointTrack) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return feet / FEET_SIDE_ON, width / WIDTH_FACING, seen
 
 
-def _log_cue(obs: np.ndarray, expected: np.ndarray) -> np.ndarray:
-    """(T, N) log-likelihood of each frame's cue for each yaw (0 where the cue is missing)."""
+def _cue_likelihood(obs: np.ndarray, expected: np.ndarray) -> np.ndarray:
+    """(T, N) likelihood of each frame's cue for each expected value (1 where the cue is missing)."""
     r = (obs[:, None] - expected[None]) / CUE_SD
-    ll = np.log((1.0 - CUE_OUTLIER_RATE) * np.exp(-0.5 * r**2) + CUE_OUTLIER_RATE)
-    return np.where(np.isfinite(obs)[:, None], ll, 0.0)
+    lik = (1.0 - CUE_OUTLIER_RATE) * np.exp(-0.5 * r**2) + CUE_OUTLIER_RATE
+    return np.where(np.isfinite(obs)[:, None], lik, 1.0)
 
 
-def _viterbi(emit: np.ndarray, rates: np.ndarray, rate_change: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Best (yaw index, rate index) per frame of the yaw × rate chain.
+class _Lattice:
+    """The yaw × rate × mirrored chain at one frame rate, and its moves.
 
-    Parameters
-    ----------
-    emit : (T, N) ndarray
-        Log-likelihood of each yaw bin.
-    rates : (M,) int ndarray
-        Yaw change per frame of each rate state, in yaw bins.
-    rate_change : (2K+1,) ndarray
-        Log-probability of the rate changing by -K..K rate states between frames.
+    States are arrays ``(N, M, 2)``: yaw bin, rate bin, order cue mirrored.
+    Between frames the mirrored flag may change, then the rate (by at most
+    ``K`` bins), then the yaw moves by the new rate.
     """
-    T, N = emit.shape
-    M, K = rates.size, (rate_change.size - 1) // 2
-    n_idx = (np.arange(N)[:, None] - rates[None, :]) % N  # the yaw a state came from
-    m_idx = np.arange(M)[None, :]
-    delta = np.repeat(emit[0][:, None], M, axis=1)
-    back_rate = np.zeros((T, N, M), np.int8)
-    for t in range(1, T):
-        best = np.full((N, M), -np.inf)
-        arg = np.zeros((N, M), np.int8)
-        for i, j in enumerate(range(-K, K + 1)):
-            src = np.full((N, M), -np.inf)
-            lo, hi = max(0, -j), min(M, M - j)
-            src[:, lo:hi] = delta[:, lo + j : hi + j] + rate_change[i]
-            better = src > best
-            best = np.where(better, src, best)
-            arg = np.where(better, i, arg)
-        # A state (n, m) at t came from yaw n − rate(m) at t − 1.
-        delta = best[n_idx, m_idx] + emit[t][:, None]
-        back_rate[t] = arg[n_idx, m_idx]
+
+    def __init__(self, fps: float):
+        self.fps = fps
+        self.grid = np.arange(0.0, 360.0, YAW_STEP_DEG)
+        self.N = self.grid.size
+        k_max = max(1, int(round(MAX_RATE_DEG_S / fps / YAW_STEP_DEG)))
+        self.rates = np.arange(-k_max, k_max + 1)
+        self.M = self.rates.size
+        sd = RATE_CHANGE_SD_DEG_S2 / fps**2 / YAW_STEP_DEG  # rate bins a frame
+        self.K = max(1, int(np.ceil(2.0 * sd)))
+        change = np.exp(-0.5 * (np.arange(-self.K, self.K + 1) / max(sd, 1e-9)) ** 2)
+        self.change = change / change.sum()
+        off = 1.0 / max(2.0, MIRRORED_MEAN_S * fps)
+        on = off * MIRRORED_SHARE / (1.0 - MIRRORED_SHARE)
+        self.flip = np.array([[1.0 - on, on], [off, 1.0 - off]])  # from -> to
+        # The chain has no beginning: its first frame is mirrored at the stationary share.
+        self.start = np.array([1.0 - MIRRORED_SHARE, MIRRORED_SHARE])
+        n = np.arange(self.N)[:, None]
+        self.came_from = (n - self.rates[None, :]) % self.N  # yaw at t-1 of state (n, m) at t
+        self.goes_to = (n + self.rates[None, :]) % self.N  # yaw at t+1 of yaw n moving at rate m
+        self.m = np.arange(self.M)[None, :]
+
+    def emission(self, feet: np.ndarray, width: np.ndarray) -> np.ndarray:
+        """(T, N, 2) likelihood of each frame's cues for each yaw, order cue as read and mirrored."""
+        s, c = np.sin(np.radians(self.grid)), np.cos(np.radians(self.grid))
+        lf = _cue_likelihood(feet, s)
+        return np.stack([lf * _cue_likelihood(width, c), lf * _cue_likelihood(width, -c)], axis=-1)
+
+    def _rate_mix(self, a: np.ndarray) -> np.ndarray:
+        """Sum over the previous rate (the rate-change kernel is symmetric: its own transpose)."""
+        out = np.zeros_like(a)
+        for i, j in enumerate(range(-self.K, self.K + 1)):
+            lo, hi = max(0, -j), min(self.M, self.M - j)
+            out[:, lo:hi] += self.change[i] * a[:, lo + j : hi + j]
+        return out
+
+    def forward_step(self, a: np.ndarray, e: np.ndarray) -> np.ndarray:
+        """The next frame's normalised forward message from `a` and its emission `e` (N, 2)."""
+        a = self._rate_mix(a @ self.flip)[self.came_from, self.m] * e[:, None, :]
+        return a / max(a.sum(), 1e-300)
+
+    def backward_step(self, b: np.ndarray, e: np.ndarray) -> np.ndarray:
+        """The previous frame's normalised backward message from `b` and its emission `e` (N, 2)."""
+        g = (b * e[:, None, :])[self.goes_to, self.m]
+        b = self._rate_mix(g) @ self.flip.T
+        return b / max(b.sum(), 1e-300)
+
+
+def _posterior_windows(lat: _Lattice, emit: np.ndarray):
+    """Yield ``(start, (n, N, M) posterior)`` over yaw and rate (mirrored summed out), window by window.
+
+    Forward–backward over each window of :data:`WINDOW_S` with
+    :data:`MARGIN_S` of context either side, so memory stays bounded.
+    """
+    T = emit.shape[0]
+    window = max(1, int(round(WINDOW_S * lat.fps)))
+    margin = int(round(MARGIN_S * lat.fps))
+    for start in range(0, T, window):
+        stop = min(T, start + window)
+        lo, hi = max(0, start - margin), min(T, stop + margin)
+        alpha = np.empty((hi - lo, lat.N, lat.M, 2))
+        a = lat.start * emit[lo][:, None, :] * np.ones((1, lat.M, 1))
+        alpha[0] = a / a.sum()
+        for t in range(lo + 1, hi):
+            alpha[t - lo] = lat.forward_step(alpha[t - lo - 1], emit[t])
+        b = np.ones((lat.N, lat.M, 2))
+        for t in range(hi - 1, stop - 1, -1):
+            b = lat.backward_step(b, emit[t])
+        post = np.empty((stop - start, lat.N, lat.M))
+        for t in range(stop - 1, start - 1, -1):
+            p = (alpha[t - lo] * b).sum(axis=-1)
+            post[t - start] = p / max(p.sum(), 1e-300)
+            b = lat.backward_step(b, emit[t])
+        yield start, post
+
+
+def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lattice path of greatest summed log posterior, and each frame's posterior over yaw.
+
+    The rate-change prior stays in the path's score, so the path turns as
+    smoothly as the chain allows; the posterior replaces the cues.
+
+    Returns
+    -------
+    yaw, rate : (T,) int ndarray
+        Bins of the path.
+    yaw_posterior : (T, N) ndarray
+        Each frame's posterior over the yaw bins.
+    """
+    T = emit.shape[0]
+    log_change = np.log(lat.change)
+    back = np.zeros((T, lat.N, lat.M), np.int8)
+    yaw_posterior = np.zeros((T, lat.N), np.float32)
+    delta = None
+    for start, post in _posterior_windows(lat, emit):
+        yaw_posterior[start : start + len(post)] = post.sum(axis=2)
+        for k, p in enumerate(post):
+            unary = np.log(p + 1e-9)
+            if delta is None:
+                delta = unary
+                continue
+            best = np.full((lat.N, lat.M), -np.inf)
+            arg = np.zeros((lat.N, lat.M), np.int8)
+            for i, j in enumerate(range(-lat.K, lat.K + 1)):
+                lo, hi = max(0, -j), min(lat.M, lat.M - j)
+                src = np.full((lat.N, lat.M), -np.inf)
+                src[:, lo:hi] = delta[:, lo + j : hi + j] + log_change[i]
+                better = src > best
+                best = np.where(better, src, best)
+                arg = np.where(better, i, arg)
+            # A state (n, m) at t came from yaw n − rate(m) at t − 1.
+            delta = best[lat.came_from, lat.m] + unary
+            back[start + k] = arg[lat.came_from, lat.m]
     yaw, rate = np.zeros(T, int), np.zeros(T, int)
     yaw[-1], rate[-1] = np.unravel_index(int(np.argmax(delta)), delta.shape)
     for t in range(T - 1, 0, -1):
-        yaw[t - 1] = (yaw[t] - rates[rate[t]]) % N
-        rate[t - 1] = rate[t] + int(back_rate[t, yaw[t], rate[t]]) - K
-    return yaw, rate
+        yaw[t - 1] = (yaw[t] - lat.rates[rate[t]]) % lat.N
+        rate[t - 1] = rate[t] + int(back[t, yaw[t], rate[t]]) - lat.K
+    return yaw, rate, yaw_posterior
+
+
+#: Half-width, degrees, of the yaw window counted as a reading's own (half
+#: an eighth of a turn: the turn quantiser's rounding).
+READING_HALF_WIDTH_DEG = 22.5
+
+
+def _readings(lat: _Lattice, yaw: np.ndarray, yaw_posterior: np.ndarray) -> np.ndarray:
+    """(T, 2) posterior mass near the decoded yaw θ and near its mirror image 180° − θ.
+
+    A bin counts for the reading it lies nearer to (within
+    :data:`READING_HALF_WIDTH_DEG`); side-on, where the two readings meet,
+    neither gets it.
+    """
+    n = np.arange(lat.N)[None, :]
+    mirror = (lat.N // 2 - yaw) % lat.N
+
+    def dist(a):
+        d = np.abs(n - a[:, None]) % lat.N
+        return np.minimum(d, lat.N - d) * YAW_STEP_DEG
+
+    d_path, d_mirror = dist(yaw), dist(mirror)
+    near = (d_path <= READING_HALF_WIDTH_DEG) & (d_path < d_mirror)
+    far = (d_mirror <= READING_HALF_WIDTH_DEG) & (d_mirror < d_path)
+    return np.stack([(yaw_posterior * near).sum(axis=1), (yaw_posterior * far).sum(axis=1)], axis=1)
 
 
 def decode_yaw(track: KeypointTrack) -> np.ndarray:
@@ -150,25 +296,40 @@ def decode_yaw(track: KeypointTrack) -> np.ndarray:
         and everywhere when the feet are seen in fewer than
         :data:`MIN_FEET_SEEN` of them (a track without feet landmarks).
     """
+    return decode_yaw_readings(track)[0]
+
+
+def decode_yaw_readings(track: KeypointTrack) -> tuple[np.ndarray, np.ndarray]:
+    """The yaw of :func:`decode_yaw`, and how sure the decoder is of it against its mirror image.
+
+    Parameters
+    ----------
+    track : KeypointTrack
+        As for :func:`decode_yaw`.
+
+    Returns
+    -------
+    yaw : (T,) ndarray
+        As :func:`decode_yaw` returns it.
+    readings : (T, 2) ndarray
+        Posterior probability of the yaw lying near the decoded one and near
+        its mirror image 180° − θ (the reading the feet cannot tell from it:
+        the same sin θ, turning the other way); side-on, where they meet,
+        both are small.  NaN where the yaw is.
+    """
     T = len(track)
     if T == 0:
-        return np.zeros(0)
+        return np.zeros(0), np.zeros((0, 2))
     feet, width, seen = _cues(track)
     if not seen.any() or np.isfinite(feet[seen]).mean() < MIN_FEET_SEEN:
-        return np.full(T, np.nan)
+        return np.full(T, np.nan), np.full((T, 2), np.nan)
     stride = max(1, int(round(float(track.fps) / DECODE_FPS)))
     keep = np.arange(0, T, stride)
-    fps = float(track.fps) / stride
-    grid = np.arange(0.0, 360.0, YAW_STEP_DEG)
-    s, c = np.sin(np.radians(grid)), np.cos(np.radians(grid))
-    emit = _log_cue(feet[keep], s) + _log_cue(width[keep], c)
-    k_max = max(1, int(round(MAX_RATE_DEG_S / fps / YAW_STEP_DEG)))
-    rates = np.arange(-k_max, k_max + 1)
-    sd = RATE_CHANGE_SD_DEG_S2 / fps**2 / YAW_STEP_DEG  # rate states a frame
-    K = max(1, int(np.ceil(2.0 * sd)))
-    change = -0.5 * (np.arange(-K, K + 1) / max(sd, 1e-9)) ** 2
-    change -= np.log(np.exp(change).sum())
-    yaw_i, rate_i = _viterbi(emit, rates, change)
-    unwrapped = grid[yaw_i[0]] + np.r_[0.0, np.cumsum(rates[rate_i[1:]] * YAW_STEP_DEG)]
-    out = np.interp(np.arange(T), keep, unwrapped)
-    return np.where(seen, out, np.nan)
+    lat = _Lattice(float(track.fps) / stride)
+    yaw_i, rate_i, yaw_posterior = _posterior_path(lat, lat.emission(feet[keep], width[keep]))
+    readings = _readings(lat, yaw_i, yaw_posterior)
+    unwrapped = lat.grid[yaw_i[0]] + np.r_[0.0, np.cumsum(lat.rates[rate_i[1:]] * YAW_STEP_DEG)]
+    frames = np.arange(T)
+    yaw = np.where(seen, np.interp(frames, keep, unwrapped), np.nan)
+    readings = np.stack([np.interp(frames, keep, readings[:, k]) for k in range(2)], axis=1)
+    return yaw, np.where(seen[:, None], readings, np.nan)

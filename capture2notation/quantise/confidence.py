@@ -20,7 +20,14 @@ A symbol's confidence is the product of two factors, each in [0, 1]:
   :data:`FRAME_YAW_SD_DEG` adds to the azimuth's.  For the small angles
   involved the elevation and the azimuth errors are independent normals
   along the sphere's two tangents, so the probability is the product of two normal interval
-  probabilities — exact to first order in the error, and 0.5 at a boundary.
+  probabilities — exact to first order in the error, and 0.5 at a boundary;
+* for a **turn**, where one view's front was decoded from the image
+  (``FitResult.front_readings``): the posterior probability of the front
+  as decoded against its mirror image over the turn's frames,
+  :func:`turn_probability`.  The mirror image turns the other way, and the
+  decoder tells the two apart only by the shoulders' and hips' order,
+  which a missed left/right swap reverses: a turn it cannot tell from its
+  mirror image is marked uncertain rather than guessed.
 
 A symbol whose confidence is below
 :data:`~capture2notation.notation.model.SYMBOL_UNCERTAIN_BELOW` (0.5: the
@@ -36,6 +43,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from ..body import body_frame, joint_index, segment_vectors
+from ..errors import QuantiseError
 from ..notation.model import DIRECTIONS, PART_MIDDLE_JOINT, PART_SEGMENTS, Score, Symbol
 
 __all__ = [
@@ -48,6 +56,7 @@ __all__ = [
     "direction_probability",
     "score_confidence",
     "symbol_margin_deg",
+    "turn_probability",
 ]
 
 #: Frames after a symbol's arrival that show its held pose, seconds (a
@@ -197,12 +206,36 @@ def direction_probability(held: np.ndarray, direction: str, level: str, depth: n
     return p_level * p_sector
 
 
+def turn_probability(readings: np.ndarray) -> float:
+    """Probability that a turn was read the right way round, from the front's two readings over its frames.
+
+    Parameters
+    ----------
+    readings : (n, 2) ndarray
+        Per frame of the turn, the posterior probability of the front as
+        decoded and of its mirror image (``FitResult.front_readings``); NaN
+        rows carry nothing.
+
+    Returns
+    -------
+    float
+        The decoded reading's share of the two summed over the frames; 0.5
+        where no frame tells them apart.
+    """
+    readings = np.nan_to_num(np.asarray(readings, dtype=float).reshape(-1, 2))
+    total = float(readings.sum())
+    if total <= 1e-9:
+        return 0.5
+    return float(readings[:, 0].sum()) / total
+
+
 def score_confidence(
     score: Score,
     joints: np.ndarray,
     fps: float,
     confidence: np.ndarray | None = None,
     line_of_sight: np.ndarray | None = None,
+    front_readings: np.ndarray | None = None,
 ) -> Score:
     """`score` with every symbol's confidence set (see the module docstring).
 
@@ -219,6 +252,10 @@ def score_confidence(
     line_of_sight : (3,) ndarray, optional
         The single camera's viewing axis in world coordinates (its sign is
         irrelevant); None for motion files and several cameras.
+    front_readings : (T, 2) ndarray, optional
+        ``FitResult.front_readings``; None where the capture did not decode
+        the front from the image (turns then rest on the hips' confidence
+        alone).
 
     Returns
     -------
@@ -227,6 +264,8 @@ def score_confidence(
     """
     joints = np.asarray(joints, dtype=float)
     T = joints.shape[0]
+    if front_readings is not None and np.shape(front_readings) != (T, 2):
+        raise QuantiseError(f"front_readings must have shape ({T}, 2), got {np.shape(front_readings)}")
     if confidence is None:
         confidence = np.isfinite(joints).all(axis=-1).astype(float)
     conf = np.nan_to_num(np.asarray(confidence, dtype=float))
@@ -255,6 +294,10 @@ def score_confidence(
                 else list(PART_SEGMENTS[s.part])
             )
             angle = 1.0
+            if s.is_turn and front_readings is not None and T:
+                a = min(max(int(round(float(s.start) * 60.0 / tempo * fps)), 0), T - 1)
+                b = min(max(int(round(float(s.end) * 60.0 / tempo * fps)), a + 1), T)
+                angle = turn_probability(front_readings[a:b])
         idx = [joint_index(n) for n in names]
         measured = float(np.mean(np.min(conf[w][:, idx], axis=1))) if T else 0.0
         out.append(replace(s, confidence=round(float(np.clip(measured * angle, 0.0, 1.0)), 3)))

@@ -71,3 +71,34 @@ def test_bad_shapes_are_refused(synth):
     down = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]])  # optical axis straight down
     with pytest.raises(FittingError, match="straight up or down"):
         front_from_yaw([0.0], down)
+
+
+def test_the_image_yaw_is_sure_of_each_turn_on_exact_keypoints():
+    # The virtual dancer's exact keypoints: the decoder's posterior, carried
+    # on the turned fit, prefers each turn as read to its mirror image.
+    from capture2notation.fitting.yaw import with_image_yaw
+    from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW
+    from capture2notation.quantise.confidence import turn_probability
+    from synthetic.identity_errors import truth_track
+    from synthetic.interpret import interpret
+    from synthetic.random_scores import random_score
+    from synthetic.render.camera import Camera as RenderCamera
+    from synthetic.render.job import truth_fields
+    from synthetic.render.scene import Pose
+
+    score = random_score(np.random.default_rng(500), n_beats=16, turns=True, fps=25.0)
+    motion = interpret(score, 25.0, Body())
+    pose = Pose.from_motion(motion)
+    camera = RenderCamera.for_view("front", (640, 480), pose.body.height)
+    track = truth_track(truth_fields(pose, camera))
+    joints = np.asarray(pose.joints, float)[: len(track)]
+    T = joints.shape[0]
+    fit = FitResult(25.0, np.arange(T) / 25.0, joints, np.zeros_like(joints), joints[:, 0], np.ones(joints.shape[:2]))
+    out = with_image_yaw(fit, track, camera)
+    assert out.front_readings.shape == (T, 2)
+    turns = [s for s in score.symbols if s.is_turn]
+    assert turns
+    per_s = 60.0 / float(score.tempo) * 25.0
+    for s in turns:
+        a, b = round(float(s.start) * per_s), round(float(s.end) * per_s)
+        assert turn_probability(out.front_readings[a:b]) > SYMBOL_UNCERTAIN_BELOW, (s.direction, s.amount)

@@ -6,7 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import capture2notation.keypoints.yaw as yaw_module
 from capture2notation.body import Body
+from capture2notation.keypoints.swap import MIRROR
 from capture2notation.keypoints.track import KeypointTrack
 from capture2notation.keypoints.yaw import decode_yaw
 from synthetic.identity_errors import truth_track
@@ -70,3 +72,30 @@ def test_without_feet_or_person_there_is_no_yaw():
     got = decode_yaw(track)
     assert np.all(np.isnan(got[5:9])) and np.all(np.isfinite(got[9:]))
     assert decode_yaw(KeypointTrack.empty(0, 25.0, (64, 48), "blazepose")).shape == (0,)
+
+
+@pytest.mark.parametrize("turns", [False, True])
+def test_a_stretch_of_swapped_labels_does_not_turn_the_body(turns):
+    # A second of left and right exchanged (a swap the identity decoder
+    # missed) mirrors the shoulders' and hips' order cue, as a body turned
+    # round would show it; the feet say it did not turn (the decoder's
+    # mirrored-cue state).  Without turns the dancer faces the camera.
+    track, truth = _clip(500 if turns else 2, turns=turns)
+    stretch = (track.times >= 1.0) & (track.times < 2.0)
+    track.xy[stretch] = track.xy[stretch][:, MIRROR]
+    got = decode_yaw(track)
+    assert np.mean(_err(got, truth)[stretch] <= HALF_EIGHTH_DEG) >= 0.9
+    assert np.mean(_err(got, truth) <= HALF_EIGHTH_DEG) >= 0.9
+
+
+def test_windows_of_a_long_clip_decode_as_the_whole(monkeypatch):
+    # Long clips are decoded window by window (bounded memory); with short
+    # windows the yaw is the one the whole clip gives.
+    track, truth = _clip(503)
+    whole = decode_yaw(track)
+    monkeypatch.setattr(yaw_module, "WINDOW_S", 2.0)
+    monkeypatch.setattr(yaw_module, "MARGIN_S", 2.0)
+    windowed = decode_yaw(track)
+    assert len(track) > 3 * 2.0 * track.fps  # several windows
+    assert np.mean(_err(windowed, whole) <= HALF_EIGHTH_DEG) >= 0.95
+    assert np.mean(_err(windowed, truth) <= HALF_EIGHTH_DEG) >= 0.9

@@ -11,7 +11,9 @@ import pytest
 from scipy.stats import norm
 
 from capture2notation.body import JOINTS, Body, forward_kinematics, joint_index
+from capture2notation.errors import QuantiseError
 from capture2notation.notation import Score, Symbol
+from capture2notation.notation.model import TURN_PART
 from capture2notation.quantise.confidence import (
     ANGLE_SD_DEG,
     DEPTH_SD_DEG,
@@ -19,6 +21,7 @@ from capture2notation.quantise.confidence import (
     direction_probability,
     score_confidence,
     symbol_margin_deg,
+    turn_probability,
 )
 
 
@@ -120,3 +123,34 @@ def test_the_fits_confidence_lowers_it():
     missing = joints.copy()
     missing[:, joint_index("right_wrist")] = np.nan
     assert score_confidence(_score(), missing, 25.0).symbols[0].confidence == 0.0
+
+
+@pytest.mark.parametrize(
+    ("readings", "expected"),
+    [
+        ([[0.9, 0.1], [0.7, 0.1]], 1.6 / 1.8),  # summed over the frames, not averaged per frame
+        ([[0.0, 0.0], [0.0, 0.0]], 0.5),  # side-on throughout: nothing tells the readings apart
+        ([[np.nan, np.nan], [0.1, 0.3]], 0.25),  # unknown frames carry nothing
+    ],
+)
+def test_turn_probability_is_the_decoded_readings_share(readings, expected):
+    assert turn_probability(np.array(readings)) == pytest.approx(expected, abs=1e-12)
+
+
+def _turn_score():
+    return Score.from_symbols([Symbol(1, 1, TURN_PART, "right", None, amount="1/4")], tempo=60)
+
+
+def test_a_turn_the_decoder_cannot_tell_from_its_mirror_image_is_uncertain():
+    joints = _held_arm(0.0)
+    T = joints.shape[0]
+    readings = np.zeros((T, 2))
+    readings[:, 0] = 0.9
+    readings[25:50] = [0.2, 0.7]  # during the turn (beats 1 to 2 at 60 bpm, 25 fps): mostly the mirror image
+    got = score_confidence(_turn_score(), joints, 25.0, front_readings=readings).symbols[0]
+    assert got.confidence == pytest.approx(0.2 / 0.9, abs=0.002)
+    assert got.uncertain
+    # Without readings a turn rests on the hips' confidence alone.
+    assert score_confidence(_turn_score(), joints, 25.0).symbols[0].confidence == 1.0
+    with pytest.raises(QuantiseError, match="front_readings"):
+        score_confidence(_turn_score(), joints, 25.0, front_readings=readings[:10])
