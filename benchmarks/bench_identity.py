@@ -5,14 +5,16 @@ the virtual dancer; the truth keypoints of a front camera are turned into a
 BlazePose-like track (:func:`synthetic.identity_errors.truth_track`) with the
 pose model's errors put in: one long stretch (25-45 % of the clip) read with
 left and right exchanged and every back view read as a front view.  Prints,
-before and after :func:`capture2notation.keypoints.identity.correct_identity`,
-the frames with the right identity, the frames whose facing is right, the
-facing flips away from side views, and the frames marked uncertain.
+before and after :func:`capture2notation.keypoints.identity.correct_identity`
+(and then :func:`capture2notation.keypoints.yaw.correct_mirrored`, the
+feet's and the turning's reading, as ``extract`` applies both), the frames
+with the right identity, the frames whose facing is right, the facing flips
+away from side views, and the frames marked uncertain.
 
 With ``--render DIR --renders N``, also N renders (front, 640×480, 25 fps,
 mannequin) of such scores through BlazePose: the frames with the right
-identity as BlazePose read them and after the decoder, scored against the
-renderer's keypoints.
+identity as BlazePose read them, after the decoder and after both, scored
+against the renderer's keypoints.
 
 Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S] [--render DIR --renders N]``
 """
@@ -25,6 +27,7 @@ import numpy as np
 
 from capture2notation.body import Body
 from capture2notation.keypoints.identity import correct_identity
+from capture2notation.keypoints.yaw import correct_mirrored
 from synthetic.identity_errors import facing_camera, truth_track, with_identity_errors
 from synthetic.interpret import interpret
 from synthetic.random_scores import random_score
@@ -84,7 +87,7 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16) -> None:
     from capture2notation.keypoints.evaluate import left_right_swaps, person_height_px
     from synthetic.render.job import render_score
 
-    tot = np.zeros(5)
+    tot = np.zeros(6)
     s, done = seed, 0
     while done < n_clips and s < seed + 40 * n_clips:
         score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
@@ -99,21 +102,26 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16) -> None:
         truth = read_truth(out / "truth.npz")
         raw = extract(out / "video.mp4", identity=False, progress=False)
         fixed, res = correct_identity(raw)
+        both, _ = correct_mirrored(fixed)
         radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
-        wrong = [np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0) for tr in (raw, fixed)]
+        wrong = [
+            np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0) for tr in (raw, fixed, both)
+        ]
         off = off_side_views(fields["front"], camera.R)
         face_ok = (res.facing == np.where(facing, 1, -1))[off]
         print(
             f"render seed {s - 1} ({len(raw)} frames, {int((~facing).sum())} back to camera): right identity "
-            f"as read {1 - wrong[0].mean():.1%}, decoded {1 - wrong[1].mean():.1%}; decoded facing right "
+            f"as read {1 - wrong[0].mean():.1%}, decoded {1 - wrong[1].mean():.1%}, then from the feet "
+            f"{1 - wrong[2].mean():.1%}; decoded facing right "
             f"{face_ok.mean():.1%} off side views; uncertain {res.uncertain.mean():.1%}"
         )
-        tot += [len(raw), (~wrong[0]).sum(), (~wrong[1]).sum(), face_ok.sum(), off.sum()]
+        tot += [len(raw), (~wrong[0]).sum(), (~wrong[1]).sum(), (~wrong[2]).sum(), face_ok.sum(), off.sum()]
         done += 1
     if done:
         print(
             f"RENDERS {done} clips, {int(tot[0])} frames: right identity as read {tot[1] / tot[0]:.1%}, "
-            f"decoded {tot[2] / tot[0]:.1%}; decoded facing right (off side views) {tot[3] / tot[4]:.1%}"
+            f"decoded {tot[2] / tot[0]:.1%}, then from the feet {tot[3] / tot[0]:.1%}; "
+            f"decoded facing right (off side views) {tot[4] / tot[5]:.1%}"
         )
 
 
@@ -127,13 +135,25 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     if args.render:
         rendered(args.seed, args.render, args.renders)
-    tot = {"n": 0, "before": 0, "after": 0, "face_before": 0, "face_after": 0, "nf": 0, "unc": 0, "unc_wrong": 0}
+    tot = {
+        "n": 0,
+        "before": 0,
+        "after": 0,
+        "feet": 0,
+        "face_before": 0,
+        "face_after": 0,
+        "nf": 0,
+        "unc": 0,
+        "unc_wrong": 0,
+    }
     for i in range(args.clips):
         seed = args.seed + i
         bad, sim, off_side = clip(seed, clean=args.clean)
-        _, res = correct_identity(bad)
+        fixed, res = correct_identity(bad)
+        _, feet = correct_mirrored(fixed)
         right_before = ~sim.swapped
         right_after = res.swapped == sim.swapped
+        right_feet = (res.swapped ^ (np.nan_to_num(feet.mirrored) > 0.5)) == sim.swapped
         truth_face = np.where(sim.facing, 1, -1)
         naive_face = np.where(np.sign(np.nan_to_num(bad.xy[:, 11, 0] - bad.xy[:, 12, 0])) >= 0, 1, -1)
         face_before = (naive_face == truth_face)[off_side]
@@ -141,7 +161,8 @@ def main(argv=None) -> None:
         n_back = int((~sim.facing).sum())
         print(
             f"seed {seed}: {len(bad)} frames, {n_back} back to camera, {int(sim.swapped.sum())} swapped; "
-            f"right identity {right_before.mean():.1%} -> {right_after.mean():.1%}; "
+            f"right identity {right_before.mean():.1%} -> {right_after.mean():.1%} "
+            f"(then from the feet {right_feet.mean():.1%}); "
             f"facing right {face_before.mean():.1%} -> {face_after.mean():.1%}; "
             f"facing flips truth {flips(truth_face, off_side)} decoded {flips(res.facing, off_side)}; "
             f"uncertain {res.uncertain.mean():.1%}"
@@ -149,6 +170,7 @@ def main(argv=None) -> None:
         tot["n"] += len(bad)
         tot["before"] += int(right_before.sum())
         tot["after"] += int(right_after.sum())
+        tot["feet"] += int(right_feet.sum())
         tot["nf"] += int(off_side.sum())
         tot["face_before"] += int(face_before.sum())
         tot["face_after"] += int(face_after.sum())
@@ -158,7 +180,8 @@ def main(argv=None) -> None:
     if not n:
         return
     print(
-        f"ALL {args.clips} clips, {n} frames: right identity {tot['before'] / n:.2%} -> {tot['after'] / n:.2%}; "
+        f"ALL {args.clips} clips, {n} frames: right identity {tot['before'] / n:.2%} -> {tot['after'] / n:.2%} "
+        f"(then from the feet {tot['feet'] / n:.2%}); "
         f"facing right (off side views) {tot['face_before'] / tot['nf']:.2%} -> {tot['face_after'] / tot['nf']:.2%}; "
         f"uncertain {tot['unc'] / n:.2%} (of them wrong {tot['unc_wrong']}/{tot['unc']})"
     )

@@ -42,7 +42,7 @@ class FitResult:
         (:func:`~capture2notation.fitting.yaw.with_image_yaw`): each frame's
         posterior probability of the front as decoded and of its mirror
         image, the reading the image cannot tell from it, turning the other
-        way (:func:`~capture2notation.keypoints.yaw.decode_yaw_readings`;
+        way (:func:`~capture2notation.keypoints.yaw.yaw_decoding`;
         NaN where unknown); None otherwise.
     """
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..body import body_frame, euler_to_matrix, front_of, joint_index, matrix_to_euler
 from ..errors import FittingError
-from ..keypoints.yaw import decode_yaw_readings
+from ..keypoints.yaw import yaw_decoding
 from .camera import Camera
 from .result import FitResult
 
@@ -113,5 +113,5 @@ def with_image_yaw(result: FitResult, track, camera: Camera) -> FitResult:
     FitResult
         Turned (:func:`turned_to`), with ``front_readings`` from the decoder.
     """
-    yaw, readings = decode_yaw_readings(track)
-    return turned_to(result, front_from_yaw(yaw, camera.R)).replace(front_readings=readings)
+    decoding = yaw_decoding(track)
+    return turned_to(result, front_from_yaw(decoding.yaw, camera.R)).replace(front_readings=decoding.readings)

@@ -75,7 +75,8 @@ def extract_frames(
         estimator, unchanged for a given one.
     identity : bool
         BlazePose only: decide left/right and front/back over the whole clip
-        and correct the track (:func:`~.identity.correct_identity`), which
+        and correct the track (:func:`~.identity.correct_identity`, then
+        :func:`~.yaw.correct_mirrored` from the feet and the turning), which
         sets ``identity_confidence``; otherwise it is NaN (not assessed).
 
     Returns
@@ -145,8 +146,10 @@ def extract_frames(
     )
     if identity and track.backend == "blazepose":
         from .identity import correct_identity
+        from .yaw import correct_mirrored
 
         track, _ = correct_identity(track)
+        track, _ = correct_mirrored(track)
     return track
 
 

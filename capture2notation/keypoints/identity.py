@@ -50,6 +50,7 @@ __all__ = [
     "correct_identity",
     "decode_identity",
     "identity_evidence",
+    "mirror_frames",
     "torso_and_order",
 ]
 
@@ -429,12 +430,28 @@ def correct_identity(track: KeypointTrack) -> tuple[KeypointTrack, IdentityResul
         A new track (the input is not modified) and the decision.
     """
     result = decode_identity(track)
-    sw = result.swapped
+    return mirror_frames(track, result.swapped, result.confidence), result
+
+
+def mirror_frames(track: KeypointTrack, frames: np.ndarray, identity_confidence: np.ndarray) -> KeypointTrack:
+    """A copy of `track` with the mirror reading at `frames` and the given ``identity_confidence``.
+
+    The mirror reading is the pose model's ambiguity exactly: left and right
+    landmarks exchanged and depth (image ``z`` and world ``z``) reflected.
+
+    Parameters
+    ----------
+    track : KeypointTrack
+    frames : (T,) bool ndarray
+        Frames to relabel.
+    identity_confidence : (T,) ndarray
+        The track's new ``identity_confidence``.
+    """
+    sw = np.asarray(frames, dtype=bool)
     xy, world, vis = track.xy.copy(), track.world.copy(), track.visibility.copy()
     xy[sw] = xy[sw][:, MIRROR]
     xy[sw, :, 2] = -xy[sw, :, 2]
     world[sw] = world[sw][:, MIRROR]
     world[sw, :, 2] = -world[sw, :, 2]
     vis[sw] = vis[sw][:, MIRROR]
-    fixed = replace(track, xy=xy, world=world, visibility=vis, identity_confidence=result.confidence)
-    return fixed, result
+    return replace(track, xy=xy, world=world, visibility=vis, identity_confidence=identity_confidence)

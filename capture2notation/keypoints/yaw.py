@@ -40,10 +40,11 @@ the clip.
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
-from .identity import torso_and_order
+from .identity import mirror_frames, torso_and_order
 from .track import KeypointTrack
 
 __all__ = [
@@ -61,8 +62,10 @@ __all__ = [
     "WIDTH_FACING",
     "WINDOW_S",
     "YAW_STEP_DEG",
+    "YawDecoding",
+    "correct_mirrored",
     "decode_yaw",
-    "decode_yaw_readings",
+    "yaw_decoding",
 ]
 
 #: Resolution of the yaw grid, degrees (an eighth of a turn is 9 steps).
@@ -181,7 +184,7 @@ class _Lattice:
 
 
 def _posterior_windows(lat: _Lattice, emit: np.ndarray):
-    """Yield ``(start, (n, N, M) posterior)`` over yaw and rate (mirrored summed out), window by window.
+    """Yield ``(start, (n, N, M) posterior over yaw and rate, (n,) P(mirrored))``, window by window.
 
     Forward–backward over each window of :data:`WINDOW_S` with
     :data:`MARGIN_S` of context either side, so memory stays bounded.
@@ -201,14 +204,17 @@ def _posterior_windows(lat: _Lattice, emit: np.ndarray):
         for t in range(hi - 1, stop - 1, -1):
             b = lat.backward_step(b, emit[t])
         post = np.empty((stop - start, lat.N, lat.M))
+        mirrored = np.empty(stop - start)
         for t in range(stop - 1, start - 1, -1):
-            p = (alpha[t - lo] * b).sum(axis=-1)
-            post[t - start] = p / max(p.sum(), 1e-300)
+            p = alpha[t - lo] * b
+            total = max(p.sum(), 1e-300)
+            post[t - start] = p.sum(axis=-1) / total
+            mirrored[t - start] = p[..., 1].sum() / total
             b = lat.backward_step(b, emit[t])
-        yield start, post
+        yield start, post, mirrored
 
 
-def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The lattice path of greatest summed log posterior, and each frame's posterior over yaw.
 
     The rate-change prior stays in the path's score, so the path turns as
@@ -220,14 +226,18 @@ def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.nda
         Bins of the path.
     yaw_posterior : (T, N) ndarray
         Each frame's posterior over the yaw bins.
+    mirrored : (T,) ndarray
+        Each frame's posterior probability that the order cue is mirrored.
     """
     T = emit.shape[0]
     log_change = np.log(lat.change)
     back = np.zeros((T, lat.N, lat.M), np.int8)
     yaw_posterior = np.zeros((T, lat.N), np.float32)
+    mirrored = np.zeros(T)
     delta = None
-    for start, post in _posterior_windows(lat, emit):
+    for start, post, mirrored_part in _posterior_windows(lat, emit):
         yaw_posterior[start : start + len(post)] = post.sum(axis=2)
+        mirrored[start : start + len(post)] = mirrored_part
         for k, p in enumerate(post):
             unary = np.log(p + 1e-9)
             if delta is None:
@@ -250,7 +260,7 @@ def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.nda
     for t in range(T - 1, 0, -1):
         yaw[t - 1] = (yaw[t] - lat.rates[rate[t]]) % lat.N
         rate[t - 1] = rate[t] + int(back[t, yaw[t], rate[t]]) - lat.K
-    return yaw, rate, yaw_posterior
+    return yaw, rate, yaw_posterior, mirrored
 
 
 #: Half-width, degrees, of the yaw window counted as a reading's own (half
@@ -278,6 +288,29 @@ def _readings(lat: _Lattice, yaw: np.ndarray, yaw_posterior: np.ndarray) -> np.n
     return np.stack([(yaw_posterior * near).sum(axis=1), (yaw_posterior * far).sum(axis=1)], axis=1)
 
 
+@dataclass(frozen=True)
+class YawDecoding:
+    """What :func:`yaw_decoding` read of a clip.
+
+    Attributes
+    ----------
+    yaw : (T,) ndarray
+        As :func:`decode_yaw` returns it.
+    readings : (T, 2) ndarray
+        Posterior probability of the yaw lying near the decoded one and near
+        its mirror image 180° − θ (the reading the feet cannot tell from it:
+        the same sin θ, turning the other way); side-on, where they meet,
+        both are small.  NaN where the yaw is.
+    mirrored : (T,) ndarray
+        Posterior probability that the shoulders' and hips' order is
+        mirrored (left and right swapped in the track); NaN where the yaw is.
+    """
+
+    yaw: np.ndarray
+    readings: np.ndarray
+    mirrored: np.ndarray
+
+
 def decode_yaw(track: KeypointTrack) -> np.ndarray:
     """The body's yaw towards the camera in every frame, unwrapped over the clip.
 
@@ -296,40 +329,62 @@ def decode_yaw(track: KeypointTrack) -> np.ndarray:
         and everywhere when the feet are seen in fewer than
         :data:`MIN_FEET_SEEN` of them (a track without feet landmarks).
     """
-    return decode_yaw_readings(track)[0]
+    return yaw_decoding(track).yaw
 
 
-def decode_yaw_readings(track: KeypointTrack) -> tuple[np.ndarray, np.ndarray]:
-    """The yaw of :func:`decode_yaw`, and how sure the decoder is of it against its mirror image.
+def yaw_decoding(track: KeypointTrack) -> YawDecoding:
+    """The yaw of :func:`decode_yaw` with the decoder's posterior (:class:`YawDecoding`).
 
     Parameters
     ----------
     track : KeypointTrack
         As for :func:`decode_yaw`.
-
-    Returns
-    -------
-    yaw : (T,) ndarray
-        As :func:`decode_yaw` returns it.
-    readings : (T, 2) ndarray
-        Posterior probability of the yaw lying near the decoded one and near
-        its mirror image 180° − θ (the reading the feet cannot tell from it:
-        the same sin θ, turning the other way); side-on, where they meet,
-        both are small.  NaN where the yaw is.
     """
     T = len(track)
     if T == 0:
-        return np.zeros(0), np.zeros((0, 2))
+        return YawDecoding(np.zeros(0), np.zeros((0, 2)), np.zeros(0))
     feet, width, seen = _cues(track)
     if not seen.any() or np.isfinite(feet[seen]).mean() < MIN_FEET_SEEN:
-        return np.full(T, np.nan), np.full((T, 2), np.nan)
+        return YawDecoding(np.full(T, np.nan), np.full((T, 2), np.nan), np.full(T, np.nan))
     stride = max(1, int(round(float(track.fps) / DECODE_FPS)))
     keep = np.arange(0, T, stride)
     lat = _Lattice(float(track.fps) / stride)
-    yaw_i, rate_i, yaw_posterior = _posterior_path(lat, lat.emission(feet[keep], width[keep]))
+    yaw_i, rate_i, yaw_posterior, mirrored = _posterior_path(lat, lat.emission(feet[keep], width[keep]))
     readings = _readings(lat, yaw_i, yaw_posterior)
     unwrapped = lat.grid[yaw_i[0]] + np.r_[0.0, np.cumsum(lat.rates[rate_i[1:]] * YAW_STEP_DEG)]
     frames = np.arange(T)
     yaw = np.where(seen, np.interp(frames, keep, unwrapped), np.nan)
     readings = np.stack([np.interp(frames, keep, readings[:, k]) for k in range(2)], axis=1)
-    return yaw, np.where(seen[:, None], readings, np.nan)
+    mirrored = np.interp(frames, keep, mirrored)
+    return YawDecoding(yaw, np.where(seen[:, None], readings, np.nan), np.where(seen, mirrored, np.nan))
+
+
+def correct_mirrored(track: KeypointTrack) -> tuple[KeypointTrack, YawDecoding]:
+    """The track relabelled where the yaw decoder reads its left and right swapped.
+
+    The identity decoder (:func:`~.identity.correct_identity`) judges the
+    labels by their own continuity and the pose model's face; the yaw
+    chain judges them by the feet and the body's turning, which no label
+    changes.  Frames whose order cue the chain reads mirrored more likely
+    than not take the mirror reading, and every frame's
+    ``identity_confidence`` becomes the lesser of the two decoders'
+    confidence in it.
+
+    Parameters
+    ----------
+    track : KeypointTrack
+        A track already corrected by :func:`~.identity.correct_identity`.
+
+    Returns
+    -------
+    (KeypointTrack, YawDecoding)
+        The relabelled track (the input is not modified) and the decoding
+        of the track as given (its yaw is the relabelled track's too).
+    """
+    decoding = yaw_decoding(track)
+    p = np.nan_to_num(decoding.mirrored)
+    swap = p > 0.5
+    sure = np.maximum(p, 1.0 - p)
+    conf = np.asarray(track.identity_confidence, float)
+    conf = np.where(np.isfinite(conf), np.minimum(conf, sure), conf)
+    return mirror_frames(track, swap, conf), decoding

@@ -3,14 +3,17 @@ on the virtual dancer's exact keypoints."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 import capture2notation.keypoints.yaw as yaw_module
 from capture2notation.body import Body
+from capture2notation.keypoints.identity import mirror_frames
 from capture2notation.keypoints.swap import MIRROR
 from capture2notation.keypoints.track import KeypointTrack
-from capture2notation.keypoints.yaw import decode_yaw
+from capture2notation.keypoints.yaw import correct_mirrored, decode_yaw
 from synthetic.identity_errors import truth_track
 from synthetic.interpret import interpret
 from synthetic.random_scores import random_score
@@ -99,3 +102,24 @@ def test_windows_of_a_long_clip_decode_as_the_whole(monkeypatch):
     assert len(track) > 3 * 2.0 * track.fps  # several windows
     assert np.mean(_err(windowed, whole) <= HALF_EIGHTH_DEG) >= 0.95
     assert np.mean(_err(windowed, truth) <= HALF_EIGHTH_DEG) >= 0.9
+
+
+def test_a_stretch_the_feet_say_is_mirrored_is_relabelled():
+    # A second with left and right exchanged while the dancer faces the
+    # camera: the yaw chain reads the order cue mirrored there (the feet say
+    # the body did not turn round) and correct_mirrored takes the mirror
+    # reading back; a clean track is left as it is.
+    clean, _ = _clip(2, turns=False)
+    clean = replace(clean, identity_confidence=np.ones(len(clean)))
+    bad = mirror_frames(clean, (clean.times >= 1.0) & (clean.times < 2.0), clean.identity_confidence)
+    fixed, decoding = correct_mirrored(bad)
+    stretch = (clean.times >= 1.0) & (clean.times < 2.0)
+    assert np.mean(decoding.mirrored[stretch] > 0.5) >= 0.9
+    right = np.all(np.isclose(fixed.xy, clean.xy, equal_nan=True), axis=(1, 2))
+    assert right.mean() >= 0.98
+    # A frame is only as sure as the less sure of the two decoders.
+    sure = np.maximum(decoding.mirrored, 1.0 - decoding.mirrored)
+    np.testing.assert_allclose(fixed.identity_confidence, np.minimum(1.0, sure))
+    same, decoding = correct_mirrored(clean)
+    assert np.mean(decoding.mirrored < 0.5) >= 0.98
+    np.testing.assert_array_equal(same.xy, clean.xy)
