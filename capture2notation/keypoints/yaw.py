@@ -366,9 +366,10 @@ def correct_mirrored(track: KeypointTrack) -> tuple[KeypointTrack, YawDecoding]:
     labels by their own continuity and the pose model's face; the yaw
     chain judges them by the feet and the body's turning, which no label
     changes.  Frames whose order cue the chain reads mirrored more likely
-    than not take the mirror reading, and every frame's
-    ``identity_confidence`` becomes the lesser of the two decoders'
-    confidence in it.
+    than not take the mirror reading, with the chain's probability of it
+    as their ``identity_confidence``; elsewhere the identity decoder's
+    stands (side-on the chain knows nothing of the labels and says only
+    its prior).
 
     Parameters
     ----------
@@ -384,7 +385,5 @@ def correct_mirrored(track: KeypointTrack) -> tuple[KeypointTrack, YawDecoding]:
     decoding = yaw_decoding(track)
     p = np.nan_to_num(decoding.mirrored)
     swap = p > 0.5
-    sure = np.maximum(p, 1.0 - p)
-    conf = np.asarray(track.identity_confidence, float)
-    conf = np.where(np.isfinite(conf), np.minimum(conf, sure), conf)
+    conf = np.where(swap, p, np.asarray(track.identity_confidence, float))
     return mirror_frames(track, swap, conf), decoding

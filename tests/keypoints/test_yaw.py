@@ -117,9 +117,10 @@ def test_a_stretch_the_feet_say_is_mirrored_is_relabelled():
     assert np.mean(decoding.mirrored[stretch] > 0.5) >= 0.9
     right = np.all(np.isclose(fixed.xy, clean.xy, equal_nan=True), axis=(1, 2))
     assert right.mean() >= 0.98
-    # A frame is only as sure as the less sure of the two decoders.
-    sure = np.maximum(decoding.mirrored, 1.0 - decoding.mirrored)
-    np.testing.assert_allclose(fixed.identity_confidence, np.minimum(1.0, sure))
+    # A relabelled frame is as sure as the chain; the others keep their confidence.
+    moved = decoding.mirrored > 0.5
+    np.testing.assert_allclose(fixed.identity_confidence[moved], decoding.mirrored[moved])
+    np.testing.assert_array_equal(fixed.identity_confidence[~moved], 1.0)
     same, decoding = correct_mirrored(clean)
     assert np.mean(decoding.mirrored < 0.5) >= 0.98
     np.testing.assert_array_equal(same.xy, clean.xy)
