@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from capture2notation.keypoints.swap import MIRROR
+from capture2notation.keypoints.identity import mirror_frames
 from capture2notation.keypoints.track import KeypointTrack
 
 __all__ = ["SimulatedErrors", "facing_camera", "truth_track", "with_identity_errors"]
@@ -121,26 +121,12 @@ def with_identity_errors(
     back = ~np.asarray(facing, dtype=bool)
     if back_as_front:
         swapped ^= back
-    xy, world, vis = track.xy.copy(), track.world.copy(), track.visibility.copy()
-    xy[swapped] = xy[swapped][:, MIRROR]
-    xy[swapped, :, 2] *= -1
-    world[swapped] = world[swapped][:, MIRROR]
-    world[swapped, :, 2] *= -1
-    vis[swapped] = vis[swapped][:, MIRROR]
+    # The pose model's own reading (not assessed: no identity confidence).
+    out = mirror_frames(track, swapped, np.full(T, np.nan))
+    xy, world, vis = out.xy, out.world, out.visibility
     if back_as_front:
         vis[np.ix_(back, _FACE)] = HALLUCINATED_FACE_VIS
     xy[..., :2] += rng.normal(0.0, PIXEL_NOISE_PX, xy[..., :2].shape)
     world[..., :2] += rng.normal(0.0, WORLD_NOISE_M, world[..., :2].shape)
     world[..., 2] += rng.normal(0.0, DEPTH_NOISE_M, world[..., 2].shape)
-    out = KeypointTrack(
-        fps=track.fps,
-        times=track.times,
-        image_size=track.image_size,
-        xy=xy,
-        visibility=vis,
-        presence=track.presence,
-        world=world,
-        crops=track.crops,
-        backend=track.backend,
-    )
     return out, SimulatedErrors(swapped, np.asarray(facing, dtype=bool))

@@ -147,6 +147,7 @@ class _Lattice:
         self.K = max(1, int(np.ceil(2.0 * sd)))
         change = np.exp(-0.5 * (np.arange(-self.K, self.K + 1) / max(sd, 1e-9)) ** 2)
         self.change = change / change.sum()
+        self.log_change = np.log(self.change)
         off = 1.0 / max(2.0, MIRRORED_MEAN_S * fps)
         on = off * MIRRORED_SHARE / (1.0 - MIRRORED_SHARE)
         self.flip = np.array([[1.0 - on, on], [off, 1.0 - off]])  # from -> to
@@ -170,6 +171,25 @@ class _Lattice:
             lo, hi = max(0, -j), min(self.M, self.M - j)
             out[:, lo:hi] += self.change[i] * a[:, lo + j : hi + j]
         return out
+
+    def _best_rate(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Best log score over the previous rate, and which change (index into ``change``) gave it."""
+        best = np.full(delta.shape, -np.inf)
+        arg = np.zeros(delta.shape, np.int8)
+        for i, j in enumerate(range(-self.K, self.K + 1)):
+            lo, hi = max(0, -j), min(self.M, self.M - j)
+            src = np.full(delta.shape, -np.inf)
+            src[:, lo:hi] = delta[:, lo + j : hi + j] + self.log_change[i]
+            better = src > best
+            best = np.where(better, src, best)
+            arg = np.where(better, i, arg)
+        return best, arg
+
+    def path_step(self, delta: np.ndarray, unary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The path's next log scores (N, M) from `delta` and the frame's `unary`, and their back-pointers."""
+        best, arg = self._best_rate(delta)
+        # A state (n, m) at t came from yaw n − rate(m) at t − 1.
+        return best[self.came_from, self.m] + unary, arg[self.came_from, self.m]
 
     def forward_step(self, a: np.ndarray, e: np.ndarray) -> np.ndarray:
         """The next frame's normalised forward message from `a` and its emission `e` (N, 2)."""
@@ -230,7 +250,6 @@ def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.nda
         Each frame's posterior probability that the order cue is mirrored.
     """
     T = emit.shape[0]
-    log_change = np.log(lat.change)
     back = np.zeros((T, lat.N, lat.M), np.int8)
     yaw_posterior = np.zeros((T, lat.N), np.float32)
     mirrored = np.zeros(T)
@@ -242,19 +261,8 @@ def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.nda
             unary = np.log(p + 1e-9)
             if delta is None:
                 delta = unary
-                continue
-            best = np.full((lat.N, lat.M), -np.inf)
-            arg = np.zeros((lat.N, lat.M), np.int8)
-            for i, j in enumerate(range(-lat.K, lat.K + 1)):
-                lo, hi = max(0, -j), min(lat.M, lat.M - j)
-                src = np.full((lat.N, lat.M), -np.inf)
-                src[:, lo:hi] = delta[:, lo + j : hi + j] + log_change[i]
-                better = src > best
-                best = np.where(better, src, best)
-                arg = np.where(better, i, arg)
-            # A state (n, m) at t came from yaw n − rate(m) at t − 1.
-            delta = best[lat.came_from, lat.m] + unary
-            back[start + k] = arg[lat.came_from, lat.m]
+            else:
+                delta, back[start + k] = lat.path_step(delta, unary)
     yaw, rate = np.zeros(T, int), np.zeros(T, int)
     yaw[-1], rate[-1] = np.unravel_index(int(np.argmax(delta)), delta.shape)
     for t in range(T - 1, 0, -1):
