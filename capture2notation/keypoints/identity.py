@@ -51,6 +51,7 @@ __all__ = [
     "decode_identity",
     "identity_evidence",
     "mirror_frames",
+    "toes_minus_heels",
     "torso_and_order",
 ]
 
@@ -216,6 +217,30 @@ def torso_and_order(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return torso, valid, order
 
 
+def toes_minus_heels(xy: np.ndarray, torso: np.ndarray) -> np.ndarray:
+    """The feet's toe-minus-heel image offset in each frame, both feet averaged.
+
+    Label-free: exchanging left and right leaves it as it is.
+
+    Parameters
+    ----------
+    xy : (T, 33, ≥2) ndarray
+        Image landmarks, pixels (NaN where missing; image y points down).
+    torso : (T,) ndarray
+        Torso lengths, pixels (:func:`torso_and_order`).
+
+    Returns
+    -------
+    (T, 2) ndarray
+        x and y, torso lengths; NaN where no foot is seen.
+    """
+    xy = np.asarray(xy, float)
+    with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
+        # Frames without feet average nothing (NaN): they carry no cue.
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(xy[:, list(_TOES), :2] - xy[:, list(_HEELS), :2], axis=1) / np.asarray(torso, float)[:, None]
+
+
 def identity_evidence(track: KeypointTrack) -> IdentityEvidence:
     """The decoder's per-frame evidence from a track (see the module docstring)."""
     xy = track.xy[:, :, :2]
@@ -237,7 +262,7 @@ def identity_evidence(track: KeypointTrack) -> IdentityEvidence:
         cue_nose = np.clip((head_ref - z[:, _NOSE]) / NOSE_DEPTH_M, -1.0, 1.0)
         cue_toe = np.clip(np.nanmean(z[:, list(_HEELS)] - z[:, list(_TOES)], axis=1) / TOE_DEPTH_M, -1, 1)
         belief = np.nan_to_num(np.nanmean(np.stack([cue_face, cue_nose, cue_toe], axis=1), axis=1))
-        foot_dy = np.nanmean(xy[:, list(_TOES), 1] - xy[:, list(_HEELS), 1], axis=1) / torso
+        foot_dy = toes_minus_heels(xy, torso)[:, 1]
         foot = np.nan_to_num(np.clip((foot_dy - FOOT_IMAGE_OFFSET) / FOOT_IMAGE_SPREAD, -1.0, 1.0))
     cues = BELIEF_NATS * belief + FOOT_IMAGE_NATS * foot
     temper = float(min(1.0, 1.0 / (track.fps * CUE_CORRELATION_S)))

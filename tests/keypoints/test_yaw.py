@@ -124,3 +124,19 @@ def test_a_stretch_the_feet_say_is_mirrored_is_relabelled():
     same, decoding = correct_mirrored(clean)
     assert np.mean(decoding.mirrored < 0.5) >= 0.98
     np.testing.assert_array_equal(same.xy, clean.xy)
+
+
+@pytest.mark.parametrize("seed", [521, 527])  # the draws from 500 whose back views the order cue alone loses
+def test_a_back_view_drawn_as_a_front_view_is_read_from_the_feet(seed, monkeypatch):
+    # The pose model draws a back view as a front view: every landmark of
+    # the back views labelled as its twin, so the shoulders' and hips' order
+    # says "facing the camera" throughout.  The feet's drop (toes no lower
+    # than heels) says the body has its back to the camera, and decides.
+    track, truth = _clip(seed)
+    back = _err(truth, 180.0) <= 45.0
+    track.xy[back] = track.xy[back][:, MIRROR]
+    got = decode_yaw(track)
+    assert np.mean(_err(got, truth)[back] <= HALF_EIGHTH_DEG) >= 0.95
+    # Without the drop (every frame's drop an outlier) the order cue wins.
+    monkeypatch.setattr(yaw_module, "DROP_OUTLIER_RATE", 1.0)
+    assert np.mean(_err(decode_yaw(track), truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
