@@ -17,8 +17,9 @@ depth (the yaw θ, 0 facing the camera, +90° facing the image's right):
   about level from behind or side-on (medians on development renders: 0.22,
   0.00 and 0.02 torso lengths), so the drop is ∝ max(cos θ, 0).  A raised
   heel (relevé, a pointed foot) lowers the toes as well, so a frame's drop
-  only leans one way (:data:`DROP_SD`, :data:`DROP_OUTLIER_RATE`); a
-  stretch of frames decides.
+  only leans one way, and its errors last as long as a pose is held
+  (:data:`DROP_SD`, :data:`DROP_OUTLIER_RATE`, :data:`DROP_CORRELATION_S`);
+  a stretch of frames decides.
 
 The feet's sideways cue cannot tell a turn from its mirror image (θ and
 180° − θ give the same sin θ, turning the other way); the shoulders' and
@@ -60,6 +61,7 @@ __all__ = [
     "CUE_OUTLIER_RATE",
     "CUE_SD",
     "DECODE_FPS",
+    "DROP_CORRELATION_S",
     "DROP_OUTLIER_RATE",
     "DROP_SD",
     "FEET_FACING_DROP",
@@ -120,13 +122,18 @@ WIDTH_FACING = 0.55
 #: camera's height).  A constant like the two above.
 FEET_FACING_DROP = 0.22
 #: Spread of the feet's drop about its expected value, in units of
-#: :data:`FEET_FACING_DROP`, and its share of outliers: the drop is noisy
-#: and a raised heel mimics facing, so one frame favours facing over backing
-#: by at most 1.6:1.  With the other cues' 0.35 and 5 % it read back views
-#: as front views wherever a heel stayed raised (development renders: 42 of
-#: 62 turns right against 50 without the cue and 53 with these values).
-DROP_SD = 1.0
+#: :data:`FEET_FACING_DROP`, and its share of outliers (a raised heel or a
+#: lifted foot: the drop of a pointed foot says nothing of the view).
+DROP_SD = 0.5
 DROP_OUTLIER_RATE = 0.3
+#: The drop's errors last as long as a pose is held (a heel raised for a
+#: relevé, a foot pointed behind), so each frame counts for one independent
+#: reading per this many seconds (at 25 fps a fifth: one frame favours
+#: facing over backing by at most 1.2:1, a second of them by ~100:1).  Taken
+#: as independent, a held leg gesture turned a body at 45° to the camera
+#: round to 135° for seconds (development renders at 45°: yaw within 22.5°
+#: on 74 % of frames against 95 % without the cue).
+DROP_CORRELATION_S = 0.2
 #: Frames are decoded in windows of this many seconds, each with this much
 #: context either side (a turn's evidence reaches a few seconds at most).
 WINDOW_S = 60.0
@@ -184,7 +191,8 @@ class _Lattice:
         """(T, N, 2) likelihood of each frame's cues for each yaw, order cue as read and mirrored."""
         s, c = np.sin(np.radians(self.grid)), np.cos(np.radians(self.grid))
         # Neither feet cue depends on the left/right labels.
-        lf = _cue_likelihood(feet, s) * _cue_likelihood(drop, np.maximum(c, 0.0), DROP_SD, DROP_OUTLIER_RATE)
+        weight = min(1.0, 1.0 / (self.fps * DROP_CORRELATION_S))
+        lf = _cue_likelihood(feet, s) * _cue_likelihood(drop, np.maximum(c, 0.0), DROP_SD, DROP_OUTLIER_RATE) ** weight
         return np.stack([lf * _cue_likelihood(width, c), lf * _cue_likelihood(width, -c)], axis=-1)
 
     def _rate_mix(self, a: np.ndarray) -> np.ndarray:

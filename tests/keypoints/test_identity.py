@@ -11,7 +11,13 @@ import pytest
 
 from capture2notation.body import Body
 from capture2notation.fitting.uncertainty import with_identity_confidence
-from capture2notation.keypoints.identity import IDENTITY_UNCERTAIN_BELOW, correct_identity, decode_identity
+from capture2notation.keypoints.identity import (
+    IDENTITY_UNCERTAIN_BELOW,
+    correct_identity,
+    decode_identity,
+    toes_minus_heels,
+)
+from capture2notation.keypoints.swap import MIRROR
 from capture2notation.keypoints.track import KeypointTrack
 from synthetic.identity_errors import facing_camera, truth_track, with_identity_errors
 from synthetic.interpret import interpret
@@ -144,3 +150,16 @@ def test_identity_confidence_lowers_only_sided_joints():
     np.testing.assert_allclose(out[0, sided], 0.25)
     np.testing.assert_allclose(out[0, middle], 1.0)
     np.testing.assert_allclose(out[1:], 1.0)
+
+
+def test_toes_minus_heels_by_hand_and_label_free():
+    xy = np.full((3, 33, 2), np.nan)
+    # Frame 0: both feet, toes 10 px right of and 4 px below the heels; frame 1: the left foot only.
+    xy[0, [29, 30]] = [[100.0, 200.0], [120.0, 202.0]]
+    xy[0, [31, 32]] = [[110.0, 204.0], [130.0, 206.0]]
+    xy[1, 29], xy[1, 31] = [50.0, 60.0], [40.0, 70.0]
+    got = toes_minus_heels(xy, np.array([2.0, 10.0, 1.0]))
+    np.testing.assert_allclose(got[0], [5.0, 2.0])
+    np.testing.assert_allclose(got[1], [-1.0, 1.0])
+    assert np.all(np.isnan(got[2]))  # no foot seen
+    np.testing.assert_allclose(toes_minus_heels(xy[:, MIRROR], np.array([2.0, 10.0, 1.0])), got)

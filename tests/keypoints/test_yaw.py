@@ -10,7 +10,7 @@ import pytest
 
 import capture2notation.keypoints.yaw as yaw_module
 from capture2notation.body import Body
-from capture2notation.keypoints.identity import mirror_frames
+from capture2notation.keypoints.identity import mirror_frames, torso_and_order
 from capture2notation.keypoints.swap import MIRROR
 from capture2notation.keypoints.track import KeypointTrack
 from capture2notation.keypoints.yaw import correct_mirrored, decode_yaw
@@ -25,10 +25,10 @@ from synthetic.render.scene import Pose
 HALF_EIGHTH_DEG = 22.5
 
 
-def _clip(seed: int, fps: float = 25.0, turns: bool = True):
+def _clip(seed: int, fps: float = 25.0, turns: bool = True, view: str = "front"):
     score = random_score(np.random.default_rng(seed), n_beats=16, turns=turns, fps=fps)
     pose = Pose.from_motion(interpret(score, fps, Body()))
-    camera = Camera.for_view("front", (640, 480), pose.body.height)
+    camera = Camera.for_view(view, (640, 480), pose.body.height)
     fields = truth_fields(pose, camera)
     a = np.radians(np.asarray(fields["front"], float))
     forward = np.stack([np.sin(a), np.cos(a), np.zeros_like(a)], 1) @ np.asarray(camera.R).T
@@ -140,3 +140,20 @@ def test_a_back_view_drawn_as_a_front_view_is_read_from_the_feet(seed, monkeypat
     # Without the drop (every frame's drop an outlier) the order cue wins.
     monkeypatch.setattr(yaw_module, "DROP_OUTLIER_RATE", 1.0)
     assert np.mean(_err(decode_yaw(track), truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
+
+
+def test_a_foot_held_pointed_behind_does_not_turn_the_body(monkeypatch):
+    # A second of toes drawn well above the heels (a foot lifted and pointed
+    # behind) while the body stands at 45° to the camera: the drop alone
+    # would say "back to the camera" (135°, the feet's mirror reading), but
+    # its errors persist with the pose and count for little frame by frame.
+    track, truth = _clip(4, turns=False, view="45")
+    assert np.all(_err(truth, 45.0) <= 1.0)
+    held = (track.times >= 1.0) & (track.times < 2.0)
+    torso = torso_and_order(track.xy[:, :, :2])[0]
+    for heel, toe in ((29, 31), (30, 32)):
+        track.xy[held, toe, 1] = track.xy[held, heel, 1] - 1.5 * yaw_module.FEET_FACING_DROP * torso[held]
+    assert np.mean(_err(decode_yaw(track), truth)[held] <= HALF_EIGHTH_DEG) >= 0.95
+    # Frame by frame independent, the held drop turns the body round.
+    monkeypatch.setattr(yaw_module, "DROP_CORRELATION_S", 1e-9)
+    assert np.mean(_err(decode_yaw(track), truth)[held] <= HALF_EIGHTH_DEG) <= 0.8
