@@ -7,16 +7,18 @@ pose model's errors put in: one long stretch (25-45 % of the clip) read with
 left and right exchanged and every back view read as a front view.  Prints,
 before and after :func:`capture2notation.keypoints.identity.correct_identity`
 (and then :func:`capture2notation.keypoints.yaw.correct_mirrored`, the
-feet's and the turning's reading, as ``extract`` applies both), the frames
+feet's and the turning's reading, as ``extract`` applies it), the frames
 with the right identity, the frames whose facing is right, the facing flips
 away from side views, and the frames marked uncertain.
 
-With ``--render DIR --renders N``, also N renders (front, 640×480, 25 fps,
-mannequin) of such scores through BlazePose: the frames with the right
-identity as BlazePose read them, after the decoder and after both, scored
-against the renderer's keypoints.
+With ``--render DIR --renders N``, also N renders (640×480, 25 fps,
+mannequin, the ``--view`` camera) of such scores through BlazePose: the
+frames with the right identity as BlazePose read them, after the decoder,
+after the feet's reading and after each arm and leg pair's side-on reading
+(:func:`capture2notation.keypoints.near_side.correct_near_side`; all as
+``extract`` applies them), scored against the renderer's keypoints.
 
-Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S] [--render DIR --renders N]``
+Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S] [--render DIR --renders N [--view V]]``
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import numpy as np
 
 from capture2notation.body import Body
 from capture2notation.keypoints.identity import correct_identity
+from capture2notation.keypoints.near_side import correct_near_side
 from capture2notation.keypoints.yaw import correct_mirrored
 from synthetic.identity_errors import facing_camera, truth_track, with_identity_errors
 from synthetic.interpret import interpret
@@ -71,14 +74,15 @@ def flips(facing: np.ndarray, keep: np.ndarray) -> int:
     return int(np.sum(f[1:] != f[:-1]))
 
 
-def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16) -> None:
-    """Renders of random scores with turns through BlazePose: identity as read and after the decoder.
+def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16, view: str = "front") -> None:
+    """Renders of random scores with turns through BlazePose: identity as read and after each correction.
 
-    Draws from `seed` on; a draw is rendered when its dancer turns its back
-    to the camera for at least 10 frames, until `n_clips` are done.  Prints
-    each clip and the totals: frames with the right identity as BlazePose
-    read them and after :func:`correct_identity`, and decoded facing off
-    side views.
+    Draws from `seed` on; a draw is rendered from the `view` camera when its
+    dancer turns its back to that camera for at least 10 frames, until
+    `n_clips` are done.  Prints each clip and the totals: frames with the
+    right identity as BlazePose read them, after :func:`correct_identity`,
+    after :func:`correct_mirrored` and after :func:`correct_near_side`, and
+    decoded facing off side views.
     """
     from pathlib import Path
 
@@ -87,41 +91,43 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16) -> None:
     from capture2notation.keypoints.evaluate import left_right_swaps, person_height_px
     from synthetic.render.job import render_score
 
-    tot = np.zeros(6)
+    tot = np.zeros(7)
     s, done = seed, 0
     while done < n_clips and s < seed + 40 * n_clips:
         score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
         pose = Pose.from_motion(interpret(score, 25.0, Body()))
-        camera = Camera.for_view("front", (640, 480), pose.body.height)
+        camera = Camera.for_view(view, (640, 480), pose.body.height)
         fields = truth_fields(pose, camera)
         facing = facing_camera(fields["front"], camera.R)
         s += 1
         if (~facing).sum() < 10:
             continue
-        out = render_score(score, Path(outdir) / f"r{s - 1}", progress=False)
+        out = render_score(score, Path(outdir) / f"r{s - 1}", view=view, progress=False)
         truth = read_truth(out / "truth.npz")
         raw = extract(out / "video.mp4", identity=False, progress=False)
         fixed, res = correct_identity(raw)
-        both, _ = correct_mirrored(fixed)
+        both, decoding = correct_mirrored(fixed)
+        limbs, _ = correct_near_side(both, decoding.yaw)
         radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
         wrong = [
-            np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0) for tr in (raw, fixed, both)
+            np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0)
+            for tr in (raw, fixed, both, limbs)
         ]
         off = off_side_views(fields["front"], camera.R)
         face_ok = (res.facing == np.where(facing, 1, -1))[off]
         print(
             f"render seed {s - 1} ({len(raw)} frames, {int((~facing).sum())} back to camera): right identity "
             f"as read {1 - wrong[0].mean():.1%}, decoded {1 - wrong[1].mean():.1%}, then from the feet "
-            f"{1 - wrong[2].mean():.1%}; decoded facing right "
+            f"{1 - wrong[2].mean():.1%}, then side-on limbs {1 - wrong[3].mean():.1%}; decoded facing right "
             f"{face_ok.mean():.1%} off side views; uncertain {res.uncertain.mean():.1%}"
         )
-        tot += [len(raw), (~wrong[0]).sum(), (~wrong[1]).sum(), (~wrong[2]).sum(), face_ok.sum(), off.sum()]
+        tot += [len(raw), *((~w).sum() for w in wrong), face_ok.sum(), off.sum()]
         done += 1
     if done:
         print(
             f"RENDERS {done} clips, {int(tot[0])} frames: right identity as read {tot[1] / tot[0]:.1%}, "
-            f"decoded {tot[2] / tot[0]:.1%}, then from the feet {tot[3] / tot[0]:.1%}; "
-            f"decoded facing right (off side views) {tot[4] / tot[5]:.1%}"
+            f"decoded {tot[2] / tot[0]:.1%}, then from the feet {tot[3] / tot[0]:.1%}, "
+            f"then side-on limbs {tot[4] / tot[0]:.1%}; decoded facing right (off side views) {tot[5] / tot[6]:.1%}"
         )
 
 
@@ -131,10 +137,11 @@ def main(argv=None) -> None:
     ap.add_argument("--seed", type=int, default=1600)
     ap.add_argument("--render", metavar="DIR", help="also render turning clips into DIR and run BlazePose on them")
     ap.add_argument("--renders", type=int, default=1, help="how many clips --render renders (from --seed on)")
+    ap.add_argument("--view", default="front", choices=("front", "45", "side", "-45"), help="camera of --render")
     ap.add_argument("--clean", action="store_true", help="no errors put in (false corrections)")
     args = ap.parse_args(argv)
     if args.render:
-        rendered(args.seed, args.render, args.renders)
+        rendered(args.seed, args.render, args.renders, view=args.view)
     tot = {
         "n": 0,
         "before": 0,

@@ -76,8 +76,9 @@ def extract_frames(
     identity : bool
         BlazePose only: decide left/right and front/back over the whole clip
         and correct the track (:func:`~.identity.correct_identity`, then
-        :func:`~.yaw.correct_mirrored` from the feet and the turning), which
-        sets ``identity_confidence``; otherwise it is NaN (not assessed).
+        :func:`~.yaw.correct_mirrored` from the feet and the turning, then
+        each arm and leg pair side-on, :func:`~.near_side.correct_near_side`),
+        which sets ``identity_confidence``; otherwise it is NaN (not assessed).
 
     Returns
     -------
@@ -146,10 +147,12 @@ def extract_frames(
     )
     if identity and track.backend == "blazepose":
         from .identity import correct_identity
+        from .near_side import correct_near_side
         from .yaw import correct_mirrored
 
         track, _ = correct_identity(track)
-        track, _ = correct_mirrored(track)
+        track, decoding = correct_mirrored(track)
+        track, _ = correct_near_side(track, decoding.yaw)
     return track
 
 
