@@ -205,7 +205,10 @@ def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int,
                 bar.update(1)
 
         def one(v):
-            return extract(v, backend=backend, fps=fps_override, progress=step, flip_test=flip_test, threads=threads)
+            # The views' geometry decides each arm and leg pair (match_sides), not one view's visibility.
+            return extract(
+                v, backend=backend, fps=fps_override, progress=step, flip_test=flip_test, threads=threads, limbs=False
+            )
 
         if workers <= 1:
             return [one(v) for v in videos]

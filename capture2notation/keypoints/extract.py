@@ -45,6 +45,7 @@ def extract_frames(
     progress=None,
     flip_test: bool | None = None,
     identity: bool = True,
+    limbs: bool = True,
 ) -> KeypointTrack:
     """Keypoints of a stream of frames.
 
@@ -77,8 +78,14 @@ def extract_frames(
         BlazePose only: decide left/right and front/back over the whole clip
         and correct the track (:func:`~.identity.correct_identity`, then
         :func:`~.yaw.correct_mirrored` from the feet and the turning, then
-        each arm and leg pair side-on, :func:`~.near_side.correct_near_side`),
-        which sets ``identity_confidence``; otherwise it is NaN (not assessed).
+        each arm and leg pair side-on, :func:`~.near_side.correct_near_side`,
+        unless `limbs` is off), which sets ``identity_confidence``; otherwise
+        it is NaN (not assessed).
+    limbs : bool
+        With `identity`: also decide each arm and leg pair side-on from the
+        pose model's visibility.  Several calibrated cameras decide the limbs
+        by their geometry instead (:func:`~capture2notation.fitting.triangulate.match_sides`),
+        which the visibility only disturbs, so their captures turn it off.
 
     Returns
     -------
@@ -152,7 +159,8 @@ def extract_frames(
 
         track, _ = correct_identity(track)
         track, decoding = correct_mirrored(track)
-        track, _ = correct_near_side(track, decoding.yaw)
+        if limbs:
+            track, _ = correct_near_side(track, decoding.yaw)
     return track
 
 
@@ -171,6 +179,7 @@ def extract(
     progress=False,
     flip_test: bool | None = None,
     identity: bool = True,
+    limbs: bool = True,
 ) -> KeypointTrack:
     """Keypoints of a video file or image folder.
 
@@ -185,7 +194,7 @@ def extract(
         Frame rate of an image folder (default 30) or override for a file.
     start, stop : int
         Frame range ``[start, stop)``.
-    threads, smooth, markers, estimator, flip_test, identity
+    threads, smooth, markers, estimator, flip_test, identity, limbs
         As :func:`extract_frames`.
     progress : bool or callable
         True: show progress on stderr (a bar on a terminal, else a line every
@@ -202,7 +211,7 @@ def extract(
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, progress=progress or None, flip_test=flip_test,
-            identity=identity,
+            identity=identity, limbs=limbs,
         )  # fmt: skip
     from ..progress import progress as progress_bar
 
@@ -211,5 +220,5 @@ def extract(
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, progress=lambda _i: bar.update(1), flip_test=flip_test,
-            identity=identity,
+            identity=identity, limbs=limbs,
         )  # fmt: skip
