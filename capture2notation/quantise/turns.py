@@ -146,8 +146,10 @@ def turn_movements(
         w = int(round(_SMOOTH_S * fps)) | 1
         if w >= 5 and w < T:
             front = savgol_filter(front, w, 2)
-        speed = np.abs(np.diff(front)) * fps
-        spans = movement_spans(speed, _LOW_SPEED_DEG_S, _HIGH_SPEED_DEG_S, _SPLIT_RATIO)
+        velocity = np.diff(front) * fps
+        spans = _split_reversals(
+            movement_spans(np.abs(velocity), _LOW_SPEED_DEG_S, _HIGH_SPEED_DEG_S, _SPLIT_RATIO), velocity, fps
+        )
     else:
         speed = np.abs(np.diff(front)) * fps
         origin = float(front[0])
@@ -194,6 +196,40 @@ def turn_movements(
                 amount=Fraction(abs(eighths)) * TURN_STEP,
             )
         )
+    return out
+
+
+def _split_reversals(spans: list[tuple[int, int]], velocity: np.ndarray, fps: float) -> list[tuple[int, int]]:
+    """`spans` cut where the (smoothed) rotation turns back by a turn's worth: a turn turns one way.
+
+    Without the cut, an eighth turn to the left run straight into two turns
+    to the right is read as their net 15/8 to the right: the speed between
+    them dips, but not below the split ratio of two so unequal peaks.  A
+    stretch turning back by less than :data:`MIN_MEASURED_EIGHTHS` (the
+    hips' wobble at the end of a turn) is no turn of its own and stays in.
+
+    Parameters
+    ----------
+    spans : list of (a, b)
+        Interval index ranges, inclusive.
+    velocity : (N,) ndarray
+        Smoothed rotation speed over each frame interval, degrees per second, signed.
+    fps : float
+    """
+    least = MIN_MEASURED_EIGHTHS * EIGHTH_DEG
+    out = []
+    for a, b in spans:
+        v = velocity[a : b + 1]
+        starts = np.r_[0, np.flatnonzero(np.sign(v[1:]) * np.sign(v[:-1]) < 0) + 1]
+        parts = [[int(lo), int(hi), float(v[lo:hi].sum()) / fps] for lo, hi in zip(starts, np.r_[starts[1:], v.size])]
+        # Fold the smallest stretch into its neighbours until every one turns by a turn's worth.
+        while len(parts) > 1:
+            k = int(np.argmin([abs(p[2]) for p in parts]))
+            if abs(parts[k][2]) >= least:
+                break
+            lo, hi = max(0, k - 1), min(len(parts), k + 2)
+            parts[lo:hi] = [[parts[lo][0], parts[hi - 1][1], sum(p[2] for p in parts[lo:hi])]]
+        out.extend((a + lo, a + hi - 1) for lo, hi, _ in parts)
     return out
 
 

@@ -72,6 +72,18 @@ def test_measured_turn_is_found_through_jitter():
     assert abs(got[0].start_frame - 0) <= 5 and abs(got[0].end_frame - 50) <= 5
 
 
+def test_a_measured_turn_straight_into_the_other_way_is_two_turns():
+    # An eighth to the left run straight into two turns to the right: the
+    # speed between them hardly dips next to the pirouette's, but a turn
+    # turns one way (read as one, it was their net 15/8 to the right).
+    score = _turn_score([(0, 1, "left", "1/8"), (1, 2, "right", "2")])
+    joints = interpret(score, fps=FPS).joints()
+    noisy = joints + np.random.default_rng(3).normal(0.0, 0.01, joints.shape)
+    got = turn_movements(noisy, FPS, measured=True)
+    assert [(m.direction, m.amount) for m in got] == [("left", Fraction(1, 8)), ("right", Fraction(2))]
+    assert abs(got[0].end_frame - 25) <= 3
+
+
 def test_no_turn_is_written_for_a_dancer_who_does_not_turn():
     score = Score(symbols=(Symbol(Fraction(0), Fraction(2), "right_arm", "right", "high"),), tempo=Fraction(60))
     joints = interpret(score, fps=FPS).joints()
