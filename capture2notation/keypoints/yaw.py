@@ -18,7 +18,7 @@ depth (the yaw θ, 0 facing the camera, +90° facing the image's right):
   0.00 and 0.02 torso lengths), so the drop is ∝ max(cos θ, 0).  A raised
   heel (relevé, a pointed foot) lowers the toes as well, so a frame's drop
   only leans one way, and its errors last as long as a pose is held
-  (:data:`DROP_SD`, :data:`DROP_OUTLIER_RATE`, :data:`DROP_CORRELATION_S`);
+  (:data:`DROP_SD`, :data:`DROP_OUTLIER_RATE`, :data:`DROP_WEIGHT`);
   a stretch of frames decides.
 
 The feet's sideways cue cannot tell a turn from its mirror image (θ and
@@ -61,9 +61,9 @@ __all__ = [
     "CUE_OUTLIER_RATE",
     "CUE_SD",
     "DECODE_FPS",
-    "DROP_CORRELATION_S",
     "DROP_OUTLIER_RATE",
     "DROP_SD",
+    "DROP_WEIGHT",
     "FEET_FACING_DROP",
     "FEET_SIDE_ON",
     "MARGIN_S",
@@ -127,13 +127,15 @@ FEET_FACING_DROP = 0.22
 DROP_SD = 0.5
 DROP_OUTLIER_RATE = 0.3
 #: The drop's errors last as long as a pose is held (a heel raised for a
-#: relevé, a foot pointed behind), so each frame counts for one independent
-#: reading per this many seconds (at 25 fps a fifth: one frame favours
-#: facing over backing by at most 1.2:1, a second of them by ~100:1).  Taken
-#: as independent, a held leg gesture turned a body at 45° to the camera
-#: round to 135° for seconds (development renders at 45°: yaw within 22.5°
-#: on 74 % of frames against 95 % without the cue).
-DROP_CORRELATION_S = 0.2
+#: relevé, a foot pointed behind), where the other cues' are mostly the pose
+#: model's frame-to-frame jitter, so a frame's drop counts for this share of
+#: a reading beside them (one frame then favours facing over backing by at
+#: most 1.2:1).  Taken at full weight, a held leg gesture turned a body at
+#: 45° to the camera round to 135° for seconds (development renders at 45°:
+#: yaw within 22.5° on 74 % of frames against 95 % without the cue).  A share
+#: of a frame, not a time: weighted per second instead, at 5 fps the drop
+#: outvoted the other cues and swapped a whole body for 14 frames.
+DROP_WEIGHT = 0.2
 #: Frames are decoded in windows of this many seconds, each with this much
 #: context either side (a turn's evidence reaches a few seconds at most).
 WINDOW_S = 60.0
@@ -191,8 +193,10 @@ class _Lattice:
         """(T, N, 2) likelihood of each frame's cues for each yaw, order cue as read and mirrored."""
         s, c = np.sin(np.radians(self.grid)), np.cos(np.radians(self.grid))
         # Neither feet cue depends on the left/right labels.
-        weight = min(1.0, 1.0 / (self.fps * DROP_CORRELATION_S))
-        lf = _cue_likelihood(feet, s) * _cue_likelihood(drop, np.maximum(c, 0.0), DROP_SD, DROP_OUTLIER_RATE) ** weight
+        lf = (
+            _cue_likelihood(feet, s)
+            * _cue_likelihood(drop, np.maximum(c, 0.0), DROP_SD, DROP_OUTLIER_RATE) ** DROP_WEIGHT
+        )
         return np.stack([lf * _cue_likelihood(width, c), lf * _cue_likelihood(width, -c)], axis=-1)
 
     def _rate_mix(self, a: np.ndarray) -> np.ndarray:

@@ -155,5 +155,5 @@ def test_a_foot_held_pointed_behind_does_not_turn_the_body(monkeypatch):
         track.xy[held, toe, 1] = track.xy[held, heel, 1] - 1.5 * yaw_module.FEET_FACING_DROP * torso[held]
     assert np.mean(_err(decode_yaw(track), truth)[held] <= HALF_EIGHTH_DEG) >= 0.95
     # Frame by frame independent, the held drop turns the body round.
-    monkeypatch.setattr(yaw_module, "DROP_CORRELATION_S", 1e-9)
+    monkeypatch.setattr(yaw_module, "DROP_WEIGHT", 1.0)
     assert np.mean(_err(decode_yaw(track), truth)[held] <= HALF_EIGHTH_DEG) <= 0.8
