@@ -155,10 +155,12 @@ def video(n: int, seed0: int = 20261400) -> None:
     import synthetic.random_scores as rs
     from capture2notation.compare.agreement import compare_scores
     from capture2notation.errors import C2NError
+    from capture2notation.notation.model import SYMBOL_UNCERTAIN_BELOW
     from pipelines.capture import capture
     from synthetic.render import render_score
 
     turns_ok = turns_all = flights_ok = flights_all = failed = 0
+    captured = []  # (uncertain, right) of every captured turn: how the confidence ranks them
 
     def long_flight(s, score) -> bool:  # the flights counted: at least MIN_FLIGHT_S at the score's tempo
         return s.is_air and float(s.duration) * 60 / float(score.tempo) >= MIN_FLIGHT_S
@@ -191,6 +193,14 @@ def video(n: int, seed0: int = 20261400) -> None:
                 if long_flight(s, score):
                     flights_all += 1
                     flights_ok += any(c.is_air and c.start <= s.end and s.start <= c.end for c in got.symbols)
+            for c in got.symbols:
+                if c.is_turn:
+                    right = any(
+                        s.is_turn and s.start < c.end and c.start < s.end and s.direction == c.direction
+                        and abs(s.amount - c.amount) <= Fraction(1, 8)
+                        for s in score.symbols
+                    )  # fmt: skip
+                    captured.append((c.confidence is not None and c.confidence < SYMBOL_UNCERTAIN_BELOW, right))
             a = compare_scores(score, got)
             print(
                 f"  video seed {seed0 + i}: agreement {a.symbol_agreement:.3f}, turns written "
@@ -203,6 +213,14 @@ def video(n: int, seed0: int = 20261400) -> None:
         f"video ({n} scores, front, 640x480, 25 fps, BlazePose, tempo given): turns within 1/8 and the right way "
         f"{turns_ok}/{turns_all}; flights >= 0.3 s found {flights_ok}/{flights_all}; captures failed {failed}"
     )
+    if captured:
+        unc, right = np.array(captured, bool).T
+        wrong_unc = 1.0 - right[unc].mean() if unc.any() else float("nan")
+        wrong_conf = 1.0 - right[~unc].mean() if (~unc).any() else float("nan")
+        print(
+            f"captured turns {len(right)}, right {right.mean():.0%}; marked uncertain {unc.sum()}: wrong "
+            f"{wrong_unc:.0%} against {wrong_conf:.0%} of the others (ratio {wrong_unc / max(wrong_conf, 1e-9):.1f})"
+        )
 
 
 def main() -> None:
