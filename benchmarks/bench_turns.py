@@ -165,6 +165,12 @@ def video(n: int, seed0: int = 20261400) -> None:
     def long_flight(s, score) -> bool:  # the flights counted: at least MIN_FLIGHT_S at the score's tempo
         return s.is_air and float(s.duration) * 60 / float(score.tempo) >= MIN_FLIGHT_S
 
+    def same_turn(a, b) -> bool:  # overlapping turns the same way, amounts within an eighth
+        return (
+            a.is_turn and b.is_turn and a.start < b.end and b.start < a.end and a.direction == b.direction
+            and abs(a.amount - b.amount) <= Fraction(1, 8)
+        )  # fmt: skip
+
     for i in range(n):
         score = rs.random_score(np.random.default_rng(seed0 + i), n_beats=8, turns=True, springs=True)
         with tempfile.TemporaryDirectory() as tmp:
@@ -187,20 +193,14 @@ def video(n: int, seed0: int = 20261400) -> None:
             for s in score.symbols:
                 if s.is_turn:
                     turns_all += 1
-                    match = [c for c in got.symbols if c.is_turn and c.start < s.end and s.start < c.end]
-                    hit = any(c.direction == s.direction and abs(c.amount - s.amount) <= Fraction(1, 8) for c in match)
-                    turns_ok += hit
+                    turns_ok += any(same_turn(s, c) for c in got.symbols)
                 if long_flight(s, score):
                     flights_all += 1
                     flights_ok += any(c.is_air and c.start <= s.end and s.start <= c.end for c in got.symbols)
             for c in got.symbols:
                 if c.is_turn:
-                    right = any(
-                        s.is_turn and s.start < c.end and c.start < s.end and s.direction == c.direction
-                        and abs(s.amount - c.amount) <= Fraction(1, 8)
-                        for s in score.symbols
-                    )  # fmt: skip
-                    captured.append((c.confidence is not None and c.confidence < SYMBOL_UNCERTAIN_BELOW, right))
+                    uncertain = c.confidence is not None and c.confidence < SYMBOL_UNCERTAIN_BELOW
+                    captured.append((uncertain, any(same_turn(s, c) for s in score.symbols)))
             a = compare_scores(score, got)
             print(
                 f"  video seed {seed0 + i}: agreement {a.symbol_agreement:.3f}, turns written "

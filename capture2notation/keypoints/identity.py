@@ -458,7 +458,9 @@ def correct_identity(track: KeypointTrack) -> tuple[KeypointTrack, IdentityResul
     return mirror_frames(track, result.swapped, result.confidence), result
 
 
-def mirror_frames(track: KeypointTrack, frames: np.ndarray, identity_confidence: np.ndarray) -> KeypointTrack:
+def mirror_frames(
+    track: KeypointTrack, frames: np.ndarray, identity_confidence: np.ndarray, pairs=None
+) -> KeypointTrack:
     """A copy of `track` with the mirror reading at `frames` and the given ``identity_confidence``.
 
     The mirror reading is the pose model's ambiguity exactly: left and right
@@ -471,12 +473,21 @@ def mirror_frames(track: KeypointTrack, frames: np.ndarray, identity_confidence:
         Frames to relabel.
     identity_confidence : (T,) ndarray
         The track's new ``identity_confidence``.
+    pairs : sequence of (int, int), optional
+        Only these (left, right) landmark pairs are exchanged and reflected
+        (one limb's labels, :mod:`.near_side`); default the whole body.
     """
-    sw = np.asarray(frames, dtype=bool)
+    if pairs is None:
+        perm, reflect = MIRROR, np.arange(MIRROR.size)
+    else:
+        pairs = np.asarray(pairs, dtype=int).reshape(-1, 2)
+        perm = np.arange(MIRROR.size)
+        perm[pairs[:, 0]], perm[pairs[:, 1]] = pairs[:, 1], pairs[:, 0]
+        reflect = pairs.ravel()
+    rows = np.flatnonzero(np.asarray(frames, dtype=bool))
     xy, world, vis = track.xy.copy(), track.world.copy(), track.visibility.copy()
-    xy[sw] = xy[sw][:, MIRROR]
-    xy[sw, :, 2] = -xy[sw, :, 2]
-    world[sw] = world[sw][:, MIRROR]
-    world[sw, :, 2] = -world[sw, :, 2]
-    vis[sw] = vis[sw][:, MIRROR]
+    for values in (xy, world, vis):
+        values[rows] = values[rows][:, perm]
+    for values in (xy, world):
+        values[np.ix_(rows, reflect, [2])] *= -1.0
     return replace(track, xy=xy, world=world, visibility=vis, identity_confidence=identity_confidence)

@@ -26,12 +26,12 @@ than not.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import KeypointError
-from .identity import CUE_CORRELATION_S
+from .identity import CUE_CORRELATION_S, mirror_frames
 from .track import KeypointTrack
 
 __all__ = [
@@ -148,9 +148,9 @@ def correct_near_side(track: KeypointTrack, yaw) -> tuple[KeypointTrack, NearSid
     """The track with each limb pair relabelled where its labels are more likely exchanged than not.
 
     A relabelled limb takes its twin's landmarks (image, visibility and
-    world; depth reflected, as :func:`~.identity.mirror_frames` does for
-    the whole body), and its frame's ``identity_confidence`` becomes at
-    most the chain's probability of the exchange.
+    world; depth reflected: :func:`~.identity.mirror_frames` for that pair
+    alone), and its frame's ``identity_confidence`` becomes at most the
+    chain's probability of the exchange.
 
     Parameters
     ----------
@@ -163,18 +163,11 @@ def correct_near_side(track: KeypointTrack, yaw) -> tuple[KeypointTrack, NearSid
         The relabelled track (the input is not modified) and the decoding.
     """
     decoding = decode_near_side(track, yaw)
-    xy, world, vis = track.xy.copy(), track.world.copy(), track.visibility.copy()
-    conf = np.asarray(track.identity_confidence, float).copy()
+    fixed = track
     for name, (pairs, _) in _GROUPS.items():
         p = decoding.swapped[name]
-        sw = p > 0.5
-        if not sw.any():
-            continue
-        for left, right in pairs:
-            for values in (xy, world, vis):
-                values[sw, left], values[sw, right] = values[sw, right].copy(), values[sw, left].copy()
-            for values in (xy, world):
-                values[sw, left, 2] *= -1.0
-                values[sw, right, 2] *= -1.0
-        conf[sw] = np.fmin(conf[sw], p[sw])
-    return replace(track, xy=xy, world=world, visibility=vis, identity_confidence=conf), decoding
+        swap = p > 0.5
+        if swap.any():
+            conf = np.asarray(fixed.identity_confidence, float)
+            fixed = mirror_frames(fixed, swap, np.where(swap, np.fmin(conf, p), conf), pairs=pairs)
+    return fixed, decoding
