@@ -42,6 +42,11 @@ _MIN_CLEAN_FRAMES = 1
 #: Shortest flight of measured motion, seconds: a jump of 5 cm of foot
 #: clearance lasts 0.2 s; shorter gaps are contact flicker of a fit.
 MIN_MEASURED_FLIGHT_S = 0.2
+#: Longest stretch with a foot not seen that a flight is followed through,
+#: seconds: the half turn of a 0.45-s spring hid a foot for 0.2 s on the
+#: development renders.  A touch-down hidden in it is caught by the
+#: pelvis, which cannot fall freely across a landing.
+UNSEEN_BRIDGE_S = 0.3
 #: Longest landing, seconds: a landing comes to rest within two beats at 60 bpm.
 _MAX_LANDING_S = 2.0
 #: A landing comes to rest at a pelvis speed minimum below this fraction of
@@ -80,20 +85,45 @@ def find_flights(
     """
     low, _ = foot_points(np.asarray(joints, float))
     ground = _local_floor(low, fps, floor) if measured else floor
-    # Both feet clear of the floor (a missing foot counts as unknown: no flight).
-    air = np.all(np.stack([lo - ground >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
-    if seen is not None:
-        air &= np.asarray(seen, bool).all(axis=1)
-    edges = np.flatnonzero(np.diff(np.r_[0, air.astype(int), 0]))
+    # Both feet clear of the floor; a frame with a foot not seen is unknown.
+    clear = np.all(np.stack([lo - ground >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
+    known = np.ones(clear.shape, bool) if seen is None else np.asarray(seen, bool).all(axis=1)
+    air = clear & known
+    # A spinning jump hides a foot for a few frames: next to frames seen in
+    # the air, an unseen foot is taken where the fit puts it, and the
+    # pelvis must then fall freely across the whole run (fitted feet that
+    # float before a take-off would otherwise stretch a flight back into its
+    # plié; two hops would not make one parabola).
+    bridged = _bridged(air, clear & ~known, int(np.floor(UNSEEN_BRIDGE_S * fps + 1e-9)))
     shortest = max(_MIN_CLEAN_FRAMES, int(np.ceil(MIN_MEASURED_FLIGHT_S * fps))) if measured else _MIN_CLEAN_FRAMES
     out = []
-    for a, b in zip(edges[::2], edges[1::2]):
-        if a == 0 or b >= air.size or b - a < shortest:
+    for a, b in _runs(bridged):
+        if _flight(joints, a - 1, b, shortest, fps):
+            out.append((a - 1, b))
             continue
-        t0, t1 = int(a - 1), int(b)
-        if not _ballistic(joints, t0, t1, fps):
-            continue
-        out.append((t0, t1))
+        # Not ballistic as a whole: its seen airborne runs, each on its own.
+        runs = [(a + c - 1, a + d) for c, d in _runs(air[a:b])]
+        out += [(t0, t1) for t0, t1 in runs if _flight(joints, t0, t1, shortest, fps)]
+    return out
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """``[start, end)`` of each run of True in `mask` (T,)."""
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(int), 0]))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
+
+
+def _flight(joints: np.ndarray, t0: int, t1: int, shortest: int, fps: float) -> bool:
+    """Whether take-off `t0` and touchdown `t1` frame a flight: inside the clip, long enough, ballistic."""
+    return t0 >= 0 and t1 < joints.shape[0] and t1 - t0 - 1 >= shortest and _ballistic(joints, t0, t1, fps)
+
+
+def _bridged(air: np.ndarray, maybe: np.ndarray, longest: int) -> np.ndarray:
+    """`air` (T,) with each run of `maybe` frames, at most `longest` long, that touches an airborne frame set."""
+    out = air.copy()
+    for a, b in _runs(maybe):
+        if b - a <= longest and ((a > 0 and air[a - 1]) or (b < air.size and air[b])):
+            out[a:b] = True
     return out
 
 

@@ -125,3 +125,49 @@ def test_a_leg_gesturing_through_a_flight_arrives_after_the_landing():
     score = loads(text, "lab")
     seg = segment_motion(interpret(score, fps=FPS).joints(), FPS, tempo=score.tempo)
     assert score_differences(score, seg.score) == []
+
+
+def _spring_frames(seed: int = 105):
+    score = random_scores.random_score(np.random.default_rng(seed), n_beats=8, springs=True)
+    joints = interpret(score, fps=FPS).joints()
+    frame = lambda b: int(np.floor(float(b) * 60 / float(score.tempo) * FPS + 0.5))  # noqa: E731
+    return joints, [(frame(s.start), frame(s.end)) for s, _ in springs(score)]
+
+
+def test_a_flight_is_followed_through_a_foot_hidden_mid_air():
+    # A spinning jump hides a foot for a few frames: the flight is still one
+    # flight with its own take-off and touchdown (before, each hidden frame
+    # cut it, and its pieces were too short to count).
+    joints, want = _spring_frames()
+    seen = np.ones((len(joints), 2), bool)
+    for a, b in want:
+        mid = (a + b) // 2
+        seen[mid - 1 : mid + 1, 0] = False  # right foot hidden for two frames
+        seen[mid + 1 : mid + 3, 1] = False  # then the left for two
+    assert find_flights(joints, FPS, measured=False, seen=seen) == want
+
+
+def test_an_unseen_foot_makes_no_flight_and_a_hidden_landing_is_not_flown_through():
+    joints, want = _spring_frames()
+    # Feet unseen where they stand: no airborne frame seen, no flight.
+    standing = np.ones((len(joints), 2), bool)
+    standing[: want[0][0] - 2] = False
+    got = find_flights(joints, FPS, measured=False, seen=standing)
+    assert (want[0][0], want[0][1]) not in [(a, b) for a, b in got if b < want[0][0]]
+    assert all(b > want[0][0] for _, b in got)
+    # Two hops whose landing between them is hidden: the pelvis does not fall
+    # freely across the landing, so the gap is not bridged into one flight.
+    t = np.arange(40) / FPS
+    hop = lambda t0, t1: np.where((t >= t0) & (t <= t1), 0.5 * 9.81 * (t - t0) * (t1 - t), 0.0)  # noqa: E731
+    lift = hop(0.2, 0.6) + hop(0.76, 1.16)
+    two = np.repeat(joints[:1], len(t), axis=0).copy()
+    two[..., 2] += lift[:, None]
+    from capture2notation.body import joint_index
+
+    seen = np.ones((len(t), 2), bool)
+    seen[15:20] = False  # the landing at 0.6-0.76 s (frames 15-19) unseen,
+    pelvis = two[15:20, joint_index("pelvis"), 2].copy()
+    two[15:20, :, 2] += 0.06  # and its feet fitted clear of the floor
+    two[15:20, joint_index("pelvis"), 2] = pelvis
+    got = find_flights(two, FPS, measured=False, seen=seen)
+    assert all(b - a < 15 for a, b in got) and len(got) == 2
