@@ -33,9 +33,10 @@ view from a front view.
 :func:`decode_yaw` models that directly.  The hidden state is yaw
 (:data:`YAW_STEP_DEG` grid) × yaw rate (up to :data:`MAX_RATE_DEG_S`,
 changing smoothly, :data:`RATE_CHANGE_SD_DEG_S2`, so a pirouette keeps
-turning through its side views) × whether the order cue is mirrored (a
-sticky chain: :data:`MIRRORED_SHARE` of the time, in stretches of
-:data:`MIRRORED_MEAN_S`).  Each cue is Gaussian about its expected value
+turning through its side views, or now and then suddenly,
+:data:`RATE_JUMP_SHARE`, as a turn in the air sets off) × whether the
+order cue is mirrored (a sticky chain: :data:`MIRRORED_SHARE` of the time,
+in stretches of :data:`MIRRORED_MEAN_S`).  Each cue is Gaussian about its expected value
 with a share of outliers (:data:`CUE_OUTLIER_RATE`), in units of its value
 side-on or facing the camera (:data:`FEET_SIDE_ON`, :data:`WIDTH_FACING`).
 Forward–backward gives each frame's posterior over yaw and rate, the
@@ -72,6 +73,8 @@ __all__ = [
     "MIRRORED_MEAN_S",
     "MIRRORED_SHARE",
     "RATE_CHANGE_SD_DEG_S2",
+    "RATE_JUMP_SD_DEG_S2",
+    "RATE_JUMP_SHARE",
     "READING_HALF_WIDTH_DEG",
     "WIDTH_FACING",
     "WINDOW_S",
@@ -84,13 +87,22 @@ __all__ = [
 
 #: Resolution of the yaw grid, degrees (an eighth of a turn is 9 steps).
 YAW_STEP_DEG = 5.0
-#: Fastest yaw rate searched, degrees per second: 2.8 turns a second, above
-#: a quick pirouette's two (40° a frame at 25 fps).
-MAX_RATE_DEG_S = 1000.0
+#: Fastest yaw rate searched, degrees per second: a turn in the air (a full
+#: turn in a 0.4-s spring) peaks at 1,300–1,600°/s, 60° a frame at 25 fps;
+#: a quick pirouette's two turns a second stay well inside.
+MAX_RATE_DEG_S = 1500.0
 #: Spread of the yaw rate's change, degrees per second squared: a
 #: pirouette reaches its speed within about a fifth of a second (4° a frame
 #: per frame at 25 fps; 2 and 8 measured worse on development renders).
 RATE_CHANGE_SD_DEG_S2 = 2500.0
+#: Share of frames whose rate change is sudden, and its spread, degrees per
+#: second squared: a spring's turn gets up to speed within a tenth of a
+#: second (16° a frame per frame at 25 fps).  With the smooth spread alone,
+#: full turns in the air were decoded as no turn (a full turn ends looking
+#: as it began); with it widened to 6,000 for every frame, the fitted hips'
+#: swings were read as eighth turns (development renders).
+RATE_JUMP_SHARE = 0.05
+RATE_JUMP_SD_DEG_S2 = 10000.0
 #: Frame rate the decoder runs at: faster clips are decoded on every n-th
 #: frame (the grid's rate step is one yaw step a frame) and interpolated.
 DECODE_FPS = 25.0
@@ -172,12 +184,24 @@ class _Lattice:
         self.grid = np.arange(0.0, 360.0, YAW_STEP_DEG)
         self.N = self.grid.size
         k_max = max(1, int(round(MAX_RATE_DEG_S / fps / YAW_STEP_DEG)))
+        # Below half a turn a frame: a faster rate is a slower one the other way.
+        k_max = min(k_max, self.N // 2 - 1)
         self.rates = np.arange(-k_max, k_max + 1)
         self.M = self.rates.size
         sd = RATE_CHANGE_SD_DEG_S2 / fps**2 / YAW_STEP_DEG  # rate bins a frame
-        self.K = max(1, int(np.ceil(2.0 * sd)))
-        change = np.exp(-0.5 * (np.arange(-self.K, self.K + 1) / max(sd, 1e-9)) ** 2)
-        self.change = change / change.sum()
+        jump = RATE_JUMP_SD_DEG_S2 / fps**2 / YAW_STEP_DEG
+        # No change larger than the whole range of rates.
+        self.K = min(max(1, int(np.ceil(2.0 * max(sd, jump)))), self.M - 1)
+        # Back-pointers index the 2K + 1 changes: a byte where they fit (low frame rates need more).
+        changes = 2 * self.K + 1
+        self.pointer = np.int8 if changes <= np.iinfo(np.int8).max else np.int16
+        k = np.arange(-self.K, self.K + 1)
+
+        def normal(spread: float) -> np.ndarray:
+            w = np.exp(-0.5 * (k / max(spread, 1e-9)) ** 2)
+            return w / w.sum()
+
+        self.change = (1.0 - RATE_JUMP_SHARE) * normal(sd) + RATE_JUMP_SHARE * normal(jump)
         self.log_change = np.log(self.change)
         off = 1.0 / max(2.0, MIRRORED_MEAN_S * fps)
         on = off * MIRRORED_SHARE / (1.0 - MIRRORED_SHARE)
@@ -210,7 +234,7 @@ class _Lattice:
     def _best_rate(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Best log score over the previous rate, and which change (index into ``change``) gave it."""
         best = np.full(delta.shape, -np.inf)
-        arg = np.zeros(delta.shape, np.int8)
+        arg = np.zeros(delta.shape, self.pointer)
         for i, j in enumerate(range(-self.K, self.K + 1)):
             lo, hi = max(0, -j), min(self.M, self.M - j)
             src = np.full(delta.shape, -np.inf)
@@ -285,7 +309,7 @@ def _posterior_path(lat: _Lattice, emit: np.ndarray) -> tuple[np.ndarray, np.nda
         Each frame's posterior probability that the order cue is mirrored.
     """
     T = emit.shape[0]
-    back = np.zeros((T, lat.N, lat.M), np.int8)
+    back = np.zeros((T, lat.N, lat.M), lat.pointer)
     yaw_posterior = np.zeros((T, lat.N), np.float32)
     mirrored = np.zeros(T)
     delta = None
