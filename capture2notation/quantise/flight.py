@@ -33,6 +33,7 @@ from ..notation.directions import classify_indices
 from ..notation.model import AIR, LEVELS
 from .labels import DIRECTION_NAMES, SUPPORT_HEIGHT_M, FrameLabels, foot_points
 from .movement import Movement
+from .spans import true_runs
 from .support_state import STEP_MIN_FRACTION, step_direction, support_state
 
 __all__ = ["find_flights", "landing_rest", "with_flights"]
@@ -97,20 +98,14 @@ def find_flights(
     bridged = _bridged(air, clear & ~known, int(np.floor(UNSEEN_BRIDGE_S * fps + 1e-9)))
     shortest = max(_MIN_CLEAN_FRAMES, int(np.ceil(MIN_MEASURED_FLIGHT_S * fps))) if measured else _MIN_CLEAN_FRAMES
     out = []
-    for a, b in _runs(bridged):
+    for a, b in true_runs(bridged):
         if _flight(joints, a - 1, b, shortest, fps):
             out.append((a - 1, b))
             continue
         # Not ballistic as a whole: its seen airborne runs, each on its own.
-        runs = [(a + c - 1, a + d) for c, d in _runs(air[a:b])]
+        runs = [(a + c - 1, a + d) for c, d in true_runs(air[a:b])]
         out += [(t0, t1) for t0, t1 in runs if _flight(joints, t0, t1, shortest, fps)]
     return out
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """``[start, end)`` of each run of True in `mask` (T,)."""
-    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(int), 0]))
-    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
 def _flight(joints: np.ndarray, t0: int, t1: int, shortest: int, fps: float) -> bool:
@@ -121,7 +116,7 @@ def _flight(joints: np.ndarray, t0: int, t1: int, shortest: int, fps: float) -> 
 def _bridged(air: np.ndarray, maybe: np.ndarray, longest: int) -> np.ndarray:
     """`air` (T,) with each run of `maybe` frames, at most `longest` long, that touches an airborne frame set."""
     out = air.copy()
-    for a, b in _runs(maybe):
+    for a, b in true_runs(maybe):
         if b - a <= longest and ((a > 0 and air[a - 1]) or (b < air.size and air[b])):
             out[a:b] = True
     return out

@@ -10,7 +10,7 @@ import itertools
 
 import numpy as np
 
-__all__ = ["movement_spans"]
+__all__ = ["movement_spans", "true_runs"]
 
 #: Speeds below this (degrees per second) are rounding noise of a hold, not
 #: movement; a sudden Effort's first frame still moves far more.
@@ -30,6 +30,12 @@ NEAR_POSE_SPLIT_RATIO = 0.6
 MIN_SPEED_KINK = 0.04
 #: Frames about a grid frame (before, after) where a meeting's kink may lie.
 _KINK_WINDOW = (1, 2)
+
+
+def true_runs(mask) -> list[tuple[int, int]]:
+    """``[start, end)`` frame ranges of each run of True in `mask` (T,) bool, in order."""
+    edges = np.flatnonzero(np.diff(np.r_[0, np.asarray(mask, bool).astype(int), 0]))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
 def movement_spans(
@@ -81,8 +87,7 @@ def movement_spans(
     spans: list[tuple[int, int]] = []
     if not above.any():
         return spans
-    edges = np.flatnonzero(np.diff(np.r_[0, above.astype(int), 0]))
-    runs = [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+    runs = [(a, b - 1) for a, b in true_runs(above)]
     taken = np.zeros(n, bool)
     for a, b in runs:
         if s[a : b + 1].max() <= high:
