@@ -230,3 +230,22 @@ def test_a_quarter_turn_and_straight_back_is_two_turns(seed):
     joints = interpret(_turn_score([(0, 1, "right", "1/4"), (1, 1, "left", "1/4")], tempo=120), fps=FPS).joints()
     got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
     assert [(m.direction, m.amount) for m in got] == [("right", Fraction(1, 4)), ("left", Fraction(1, 4))]
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_two_measured_turns_the_same_way_back_to_back_are_two_turns(seed):
+    """A quarter turn straight into a half turn, both right: the turning all but stops between them."""
+    rng = np.random.default_rng(seed)
+    joints = interpret(_turn_score([(0, 2, "right", "1/4"), (2, 2, "right", "1/2")]), fps=FPS).joints()
+    got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
+    assert [(m.direction, m.amount) for m in got] == [("right", Fraction(1, 4)), ("right", Fraction(1, 2))]
+    assert abs(got[0].end_frame - 50) <= 5 and abs(got[1].start_frame - 50) <= 5
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_slow_measured_eighth_turn_is_written(seed):
+    """An eighth over four beats at 60 bpm (11°/s), through jitter."""
+    rng = np.random.default_rng(seed)
+    joints = interpret(_turn_score([(1, 4, "left", "1/8")]), fps=FPS).joints()
+    got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
+    assert [(m.direction, m.amount) for m in got] == [("left", Fraction(1, 8))]
