@@ -22,6 +22,8 @@ Printed (never asserted):
   and the agreement on every column but the front (gestures, supports).
   ``--no-turns`` renders scores without turns instead: the same agreement
   on phrases that do not turn.
+* ``--speed`` (alone): time and peak memory of the room-direction decoder
+  (``quantise.front_levels``) on 1-, 10- and 60-minute measured fronts.
 """
 
 from __future__ import annotations
@@ -235,6 +237,36 @@ def video(n: int, seed0: int = 20261400, turns: bool = True) -> None:
         )
 
 
+def speed(minutes=(1, 10, 60), fps: float = 25.0, seed: int = 0) -> None:
+    """Time and peak memory of the room-direction decoder on long measured fronts."""
+    import tracemalloc
+
+    from capture2notation.quantise.front_levels import ERROR_CORRELATION_S, FRONT_SD_DEG, decode_front_levels
+
+    rng = np.random.default_rng(seed)
+    print("\n## decode_front_levels on a measured front (a turn of 1-16 eighths every 4 s, the fit's noise)\n")
+    print("| clip | frames | seconds | frames/s | peak memory |")
+    print("|---|---|---|---|---|")
+    for m in minutes:
+        T = int(m * 60 * fps)
+        steps = np.zeros(T)
+        steps[:: int(4 * fps)] = 45.0 * rng.integers(-16, 17, size=steps[:: int(4 * fps)].size)
+        a = np.exp(-1.0 / (ERROR_CORRELATION_S * fps))
+        noise = np.zeros(T)
+        shocks = rng.normal(0.0, FRONT_SD_DEG * np.sqrt(1 - a * a), T)
+        for t in range(1, T):  # AR(1): the fit's errors last ERROR_CORRELATION_S
+            noise[t] = a * noise[t - 1] + shocks[t]
+        front = np.cumsum(steps) + noise
+        t0 = time.perf_counter()
+        decode_front_levels(front, fps)
+        dt = time.perf_counter() - t0
+        tracemalloc.start()  # a second run: tracing slows allocation several times over
+        decode_front_levels(front, fps)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        print(f"| {m} min | {T} | {dt:.1f} | {T / dt:,.0f} | {peak / 2**20:.0f} MB |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=30)
@@ -247,7 +279,11 @@ def main() -> None:
         "--no-turns", action="store_true", help="--video scores without turns: the control for the other columns"
     )
     ap.add_argument("--skip-bvh", action="store_true")
+    ap.add_argument("--speed", action="store_true", help="time and memory of the turn decoder on 1-60 min fronts")
     args = ap.parse_args()
+    if args.speed:
+        speed()
+        return
     if args.seeds > 0:  # --seeds 0: the video figures alone
         round_trip(args.seeds, args.seed0)
     kinect()

@@ -62,8 +62,10 @@ EXTRA_EIGHTH_COST = float(np.log(2.0))
 #: Fastest turn followed, degrees per second (a full turn in the air, as
 #: :data:`capture2notation.keypoints.yaw.MAX_RATE_DEG_S`).
 _MAX_RATE_DEG_S = 1500.0
-#: Levels kept either side of the one nearest the measured front, eighths:
-#: a frame 135° from the front held costs more than starting a turn.
+#: Levels kept either side of the one nearest the measured front, eighths
+#: (a frame 135° from the front held costs more than starting a turn); also
+#: the most a turn may move in one frame (at 25 fps, 60° a frame is the
+#: fastest turn's 1,500°/s; below 8 fps the band is the limit).
 _BAND = 3
 #: The dancer starts on the room direction nearest the median front over
 #: this long from the first frame, seconds (five frames at 25 fps).
@@ -137,7 +139,15 @@ def decode_front_levels(front, fps: float) -> FrontLevels:
     origin = _origin(f, fps)
     # Levels further than _BAND eighths from the front are never on the path
     # (a frame there costs as much as a turn): each frame keeps a band.
-    base = np.round((f - origin) / _EIGHTH_DEG).astype(int)
+    reach = min(_BAND, int(np.ceil(_MAX_RATE_DEG_S / fps / _EIGHTH_DEG)))
+    # The band follows the front as fast as a turn can, so some state of
+    # each frame is reachable from the last (a front jumping further is
+    # followed as fast as the chain allows).
+    nearest = np.round((f - origin) / _EIGHTH_DEG).astype(int)
+    base = np.empty(T, int)
+    base[0] = nearest[0]
+    for t in range(1, T):
+        base[t] = base[t - 1] + min(reach, max(-reach, int(nearest[t] - base[t - 1])))
     band = np.arange(-_BAND, _BAND + 1)
     W = band.size
     resid = f[:, None] - (origin + _EIGHTH_DEG * (base[:, None] + band[None, :]))
@@ -147,7 +157,6 @@ def decode_front_levels(front, fps: float) -> FrontLevels:
     p_end = min(0.5, 1.0 / (TURN_MEAN_S * fps))
     start, stay = -np.log(p_start / 2.0), -np.log1p(-p_start)
     end, keep = -np.log(p_end), -np.log1p(-p_end)
-    reach = min(_BAND, int(np.ceil(_MAX_RATE_DEG_S / fps / _EIGHTH_DEG)))
     # acc[regime, j]: regimes hold, right, left; band index j.
     acc = np.full((3, W), np.inf)
     zero = int(np.clip(_BAND - base[0], 0, W - 1))

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import hypothesis.extra.numpy as hnp
+import hypothesis.strategies as st
 import numpy as np
 import pytest
+from hypothesis import given, settings
 
 from capture2notation.quantise.front_levels import (
+    _BAND,
+    _MAX_RATE_DEG_S,
     ERROR_CORRELATION_S,
     FRONT_SD_DEG,
     decode_front_levels,
@@ -82,3 +87,17 @@ def test_the_room_directions_are_those_of_the_holds_not_of_the_camera():
 def test_an_empty_front_has_no_levels():
     got = decode_front_levels(np.zeros(0), FPS)
     assert got.level.shape == (0,)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    front=hnp.arrays(np.float64, st.integers(1, 120), elements=st.floats(-5000.0, 5000.0)),
+    fps=st.floats(5.0, 200.0),
+)
+def test_any_finite_front_decodes_to_whole_eighths_reached_at_the_fastest_turn(front, fps):
+    got = decode_front_levels(front, fps)
+    assert got.level.shape == front.shape and got.level.dtype.kind == "i"
+    assert np.isfinite(got.origin_deg)
+    # No frame moves faster than the decoder follows (MAX_RATE_DEG_S, in eighths a frame).
+    reach = min(_BAND, np.ceil(_MAX_RATE_DEG_S / fps / 45.0))
+    assert np.all(np.abs(np.diff(got.level)) <= reach)
