@@ -130,8 +130,8 @@ def turn_movements(
     fps : float
         Frames per second.
     measured : bool
-        Fitted or recorded motion (smoothed, cut at speed minima) rather
-        than clean truth.
+        Fitted or recorded motion (the room directions held decoded from
+        its front, :func:`_measured_turns`) rather than clean truth.
     on_grid : (T,) ndarray of bool, optional
         Clean motion: frames of the beat grid, where back-to-back turns may part.
 
@@ -196,10 +196,12 @@ def _measured_turns(front: np.ndarray, fps: float) -> list[tuple[int, int, int]]
 
     The room directions held come from :func:`~.front_levels.decode_front_levels`;
     a turn is a run of level changes the same way, unless the front stands
-    still between two of them for :data:`_HELD_S` (two turns the same way)
-    — a turn turns one way, so a change back starts another.  Its start and
-    arrival are those of the straight ramp between the fronts held before
-    and after that fits the front best (:func:`_ramp`).
+    still between two of them for :data:`_HELD_S` or the turning all but
+    stops (:func:`_split_at_pauses`) — a turn turns one way, so a change
+    back starts another.  Its start and arrival are first those of the
+    straight ramp between the fronts held before and after that fits the
+    front best (:func:`_ramp`), then widened to where the front stands
+    still, or to the slowest frame between it and a turn it runs into.
     """
     level = decode_front_levels(front, fps).level
     changes = np.flatnonzero(np.diff(level)) + 1
@@ -207,7 +209,8 @@ def _measured_turns(front: np.ndarray, fps: float) -> list[tuple[int, int, int]]
         return []
     w = int(round(_SMOOTH_S * fps)) | 1
     smooth = savgol_filter(front, w, 2) if 5 <= w < front.size else front
-    still = np.abs(np.gradient(smooth)) * fps < _LOW_SPEED_DEG_S
+    speed = np.abs(np.gradient(smooth)) * fps
+    still = speed < _LOW_SPEED_DEG_S
     held = max(1, int(round(_HELD_S * fps)))
     groups = [[int(changes[0])]]
     for c in changes[1:].tolist():
@@ -217,7 +220,6 @@ def _measured_turns(front: np.ndarray, fps: float) -> list[tuple[int, int, int]]
             groups[-1].append(c)
         else:
             groups.append([c])
-    speed = np.abs(np.gradient(smooth)) * fps
     groups = [part for g in groups for part in _split_at_pauses(g, speed, held)]
     # Turns that follow one another without the front standing still for
     # _HELD_S meet at the slowest frame between them.
