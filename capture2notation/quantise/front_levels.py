@@ -34,6 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import QuantiseError
+from ..keypoints.yaw import MAX_RATE_DEG_S
+
 __all__ = [
     "ERROR_CORRELATION_S",
     "EXTRA_EIGHTH_COST",
@@ -59,13 +62,11 @@ TURNS_PER_S = 0.5
 TURN_MEAN_S = 1.0
 #: Cost of each eighth a turn turns, nats: each more eighth half as likely.
 EXTRA_EIGHTH_COST = float(np.log(2.0))
-#: Fastest turn followed, degrees per second (a full turn in the air, as
-#: :data:`capture2notation.keypoints.yaw.MAX_RATE_DEG_S`).
-_MAX_RATE_DEG_S = 1500.0
 #: Levels kept either side of the one nearest the measured front, eighths
 #: (a frame 135° from the front held costs more than starting a turn); also
-#: the most a turn may move in one frame (at 25 fps, 60° a frame is the
-#: fastest turn's 1,500°/s; below 8 fps the band is the limit).
+#: the most a turn may move in one frame (at 25 fps the fastest turn the
+#: yaw decoder follows, ``MAX_RATE_DEG_S``, is 60° a frame; below 8 fps the
+#: band is the limit).
 _BAND = 3
 #: The dancer starts on the room direction nearest the median front over
 #: this long from the first frame, seconds (five frames at 25 fps).
@@ -108,7 +109,7 @@ def _origin(front: np.ndarray, fps: float) -> float:
     if abs(mean) < 1e-9:
         return start
     o = float(np.degrees(np.angle(mean))) * _EIGHTH_DEG / 360.0
-    # Level 0 is the direction nearest the first frame's front.
+    # Level 0 is the direction nearest where the dancer starts.
     return o + _EIGHTH_DEG * round((start - o) / _EIGHTH_DEG)
 
 
@@ -133,13 +134,18 @@ def decode_front_levels(front, fps: float) -> FrontLevels:
     FrontLevels
     """
     f = np.asarray(front, float)
+    if f.ndim != 1 or not np.isfinite(f).all():
+        bad = "not one-dimensional" if f.ndim != 1 else f"not finite at frame {int(np.flatnonzero(~np.isfinite(f))[0])}"
+        raise QuantiseError(f"a front to decode must be a finite (T,) series of degrees: {bad}")
+    if not np.isfinite(fps) or fps <= 0:
+        raise QuantiseError(f"fps must be a positive number, got {fps!r}")
     T = f.size
     if T == 0:
         return FrontLevels(np.zeros(0, int), 0.0)
     origin = _origin(f, fps)
     # Levels further than _BAND eighths from the front are never on the path
     # (a frame there costs as much as a turn): each frame keeps a band.
-    reach = min(_BAND, int(np.ceil(_MAX_RATE_DEG_S / fps / _EIGHTH_DEG)))
+    reach = min(_BAND, int(np.ceil(MAX_RATE_DEG_S / fps / _EIGHTH_DEG)))
     # The band follows the front as fast as a turn can, so some state of
     # each frame is reachable from the last (a front jumping further is
     # followed as fast as the chain allows).

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
+from capture2notation.errors import QuantiseError
+from capture2notation.keypoints.yaw import MAX_RATE_DEG_S
 from capture2notation.quantise.front_levels import (
     _BAND,
-    _MAX_RATE_DEG_S,
     ERROR_CORRELATION_S,
     FRONT_SD_DEG,
     decode_front_levels,
@@ -99,5 +100,19 @@ def test_any_finite_front_decodes_to_whole_eighths_reached_at_the_fastest_turn(f
     assert got.level.shape == front.shape and got.level.dtype.kind == "i"
     assert np.isfinite(got.origin_deg)
     # No frame moves faster than the decoder follows (MAX_RATE_DEG_S, in eighths a frame).
-    reach = min(_BAND, np.ceil(_MAX_RATE_DEG_S / fps / 45.0))
+    reach = min(_BAND, np.ceil(MAX_RATE_DEG_S / fps / 45.0))
     assert np.all(np.abs(np.diff(got.level)) <= reach)
+
+
+@pytest.mark.parametrize(
+    ("front", "fps", "says"),
+    [
+        (np.array([0.0, np.nan, 3.0]), FPS, "frame 1"),
+        (np.zeros((3, 2)), FPS, "one-dimensional"),
+        (np.zeros(3), 0.0, "fps"),
+        (np.zeros(3), float("nan"), "fps"),
+    ],
+)
+def test_a_bad_front_or_frame_rate_is_a_quantise_error_naming_it(front, fps, says):
+    with pytest.raises(QuantiseError, match=says):
+        decode_front_levels(front, fps)
