@@ -173,7 +173,10 @@ def segment_motion(
     measured = not has_exact_holds(labels, joints)
     # Turns are read from the motion as it is; supports and steps from the
     # motion with its turns undone about their pivots (:mod:`.travel`).
-    turning, turned = joints, turned_so_far(joints, fps, measured)
+    # Measured turns never use the beat grid: read once, they serve every pass.
+    turning = joints
+    measured_turns = turn_movements(joints, fps, measured=True) if measured else None
+    turned = turned_so_far(joints, fps, measured, measured_turns)
     # The camera's line of sight in body axes, from the body as it faces the camera.
     depth = None if line_of_sight is None or not measured else depth_axes(body_frame(joints), line_of_sight)
     if np.any(turned != 0.0):
@@ -209,7 +212,7 @@ def segment_motion(
                 flights,
                 height,
             )
-            + turn_movements(turning, fps, measured)
+            + (measured_turns if measured else turn_movements(turning, fps, measured))
         )
         clean = not measured and all(noise_deg(labels.vectors[:, labels.index(p)]) <= CLEAN_NOISE_DEG for p in LIMBS)
         # Gestures set the tempo when there are a few of them: support
@@ -257,7 +260,7 @@ def segment_motion(
     )
     if moves is None or not noisy:
         on_grid = grid_frames(T, fps, tempo, params.grid)
-        turns = turn_movements(turning, fps, measured, on_grid)
+        turns = measured_turns if measured else turn_movements(turning, fps, measured, on_grid)
         ends = np.zeros(T, bool)
         ends[[min(m.end_frame, T - 1) for m in turns]] = True
         take_offs = np.zeros(T, bool)

@@ -342,13 +342,15 @@ def _feet_turn_too(feet: np.ndarray, a: int, b: int, delta: float, window: int =
     return bool(np.nanmax(np.sign(delta) * d) >= FEET_TURN_FRACTION * abs(delta) - noise)
 
 
-def turned_so_far(joints: np.ndarray, fps: float, measured: bool) -> np.ndarray:
+def turned_so_far(joints: np.ndarray, fps: float, measured: bool, turns: list[Movement] | None = None) -> np.ndarray:
     """(T,) degrees the dancer has turned by each frame: the front, held still outside turns.
 
     Clean motion's front changes only inside turns, so it is the front
     itself (from frame 0).  A measured front wanders by a few degrees
     between turns; that wander is not a turn, so outside the turns of
     :func:`turn_movements` the value is held (the smoothed front inside them).
+    `turns` are those measured turns when the caller has already read them
+    (``turn_movements(joints, fps, measured=True)``).
     """
     front = continuous_front(joints)
     T = front.size
@@ -360,7 +362,7 @@ def turned_so_far(joints: np.ndarray, fps: float, measured: bool) -> np.ndarray:
     smooth = savgol_filter(front, w, 2) if w >= 5 and w < T else front
     out = np.zeros(T)
     held, done = 0.0, 0
-    for m in turn_movements(joints, fps, measured=True):
+    for m in turn_movements(joints, fps, measured=True) if turns is None else turns:
         a, b = m.start_frame, min(m.end_frame, T - 1)
         out[done:a] = held
         # Inside the turn: the smoothed front, continuous at its start.
