@@ -163,7 +163,7 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     def fit_window(view: int, frames: slice):
         track, span = tracks[view], spans[view]
         camera = Camera.from_calibration(known, videos[view], track.image_size, undistorted=True)
-        part = _frames(track, slice(span.start + frames.start, span.start + frames.stop))
+        part = track.frames(slice(span.start + frames.start, span.start + frames.stop))
         return fit_track(undistort_track(part, known, videos[view]), camera=camera)
 
     visibility = [t.visibility[s] for t, s in zip(tracks, spans)]
@@ -171,22 +171,6 @@ def _monocular_fill(joints, jconf, missing, tracks, spans, videos, calibration, 
     view, joints, jconf = fill_from_view(joints, jconf, missing, floor, visibility, fps, fit_window)
     log.info("capture: %d joint-frames from %s's monocular fit", int(missing.sum()), videos[view])
     return joints, jconf
-
-
-def _frames(track, frames: slice):
-    """`track` cut to `frames`."""
-    from dataclasses import replace
-
-    return replace(
-        track,
-        times=track.times[frames],
-        xy=track.xy[frames],
-        visibility=track.visibility[frames],
-        presence=track.presence[frames],
-        world=track.world[frames],
-        crops=track.crops[frames],
-        identity_confidence=np.asarray(track.identity_confidence)[frames],
-    )
 
 
 def _keypoints(videos, backend, fps_override, progress, flip_test, workers: int, frames: int | None = None):

@@ -46,6 +46,7 @@ def extract_frames(
     flip_test: bool | None = None,
     identity: bool = True,
     limbs: bool = True,
+    faces: bool = True,
 ) -> KeypointTrack:
     """Keypoints of a stream of frames.
 
@@ -86,6 +87,10 @@ def extract_frames(
         pose model's visibility.  Several calibrated cameras decide the limbs
         by their geometry instead (:func:`~capture2notation.fitting.triangulate.match_sides`),
         which the visibility only disturbs, so their captures turn it off.
+    faces : bool
+        BlazePose only: look for a face at the head every
+        :data:`~.face.FACE_EVERY_S` (the track's ``face``; the yaw decoder
+        reads it as a cue of facing the camera).
 
     Returns
     -------
@@ -107,8 +112,13 @@ def extract_frames(
     if flip_test is not None and hasattr(est, "flip_test"):
         est.flip_test = bool(flip_test)
     est.reset()
-    times, xy, vis, pres, world, crops = [], [], [], [], [], []
+    times, xy, vis, pres, world, crops, face = [], [], [], [], [], [], []
     size = None
+    detector, next_face = None, -np.inf
+    if faces and est.backend == "blazepose":
+        from .face import FACE_EVERY_S, FaceDetector
+
+        detector = FaceDetector()
     last_image, r = None, None
     for i, item in enumerate(frames):
         frame = item if isinstance(item, Frame) else Frame(i, i / float(fps), np.asarray(item))
@@ -137,6 +147,11 @@ def extract_frames(
             pres.append(r.presence)
             world.append(r.world)
             crops.append(r.crop)
+        face.append(np.nan)
+        if detector is not None and r is not None and frame.time >= next_face:
+            face[-1] = detector(frame.image, r.xy)
+            # Half a frame early counts as on time: frame times are rounded.
+            next_face = frame.time + FACE_EVERY_S - 0.5 / float(fps)
         if progress is not None:
             progress(frame.index)
     if size is None:
@@ -151,6 +166,7 @@ def extract_frames(
         world=np.array(world),
         crops=np.array(crops),
         backend=est.backend,
+        face=np.array(face),
     )
     if identity and track.backend == "blazepose":
         from .identity import correct_identity
@@ -180,6 +196,7 @@ def extract(
     flip_test: bool | None = None,
     identity: bool = True,
     limbs: bool = True,
+    faces: bool = True,
 ) -> KeypointTrack:
     """Keypoints of a video file or image folder.
 
@@ -194,7 +211,7 @@ def extract(
         Frame rate of an image folder (default 30) or override for a file.
     start, stop : int
         Frame range ``[start, stop)``.
-    threads, smooth, markers, estimator, flip_test, identity, limbs
+    threads, smooth, markers, estimator, flip_test, identity, limbs, faces
         As :func:`extract_frames`.
     progress : bool or callable
         True: show progress on stderr (a bar on a terminal, else a line every
@@ -211,7 +228,7 @@ def extract(
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, progress=progress or None, flip_test=flip_test,
-            identity=identity, limbs=limbs,
+            identity=identity, limbs=limbs, faces=faces,
         )  # fmt: skip
     from ..progress import progress as progress_bar
 
@@ -220,5 +237,5 @@ def extract(
         return extract_frames(
             frames, info.fps, backend=backend, model=model, threads=threads, smooth=smooth,
             markers=markers, estimator=estimator, progress=lambda _i: bar.update(1), flip_test=flip_test,
-            identity=identity, limbs=limbs,
+            identity=identity, limbs=limbs, faces=faces,
         )  # fmt: skip

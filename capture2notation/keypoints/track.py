@@ -6,7 +6,7 @@ visibility 0, never zeros.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +29,8 @@ LANDMARK_NAMES: tuple[str, ...] = (
 NUM_LANDMARKS = len(LANDMARK_NAMES)
 
 _FIELDS = ("fps", "times", "image_size", "xy", "visibility", "presence", "world", "crops", "backend")
+#: Fields an older track may lack (read as NaN: not assessed).
+_OPTIONAL = ("identity_confidence", "face")
 
 
 def landmark_index(name: str) -> int:
@@ -71,6 +73,10 @@ class KeypointTrack:
         (:func:`~capture2notation.keypoints.identity.correct_identity`); NaN
         where not assessed, 0 where no person was seen.  Optional in the
         ``.npz`` (older tracks read as NaN).
+    face : (T,) ndarray
+        1 where a face detector found a face at the head, 0 where it found
+        none, NaN where not assessed (:mod:`~capture2notation.keypoints.face`;
+        a label-free cue of facing the camera).  Optional in the ``.npz``.
     """
 
     fps: float
@@ -84,6 +90,7 @@ class KeypointTrack:
     backend: str = "blazepose"
     names: tuple[str, ...] = field(default=LANDMARK_NAMES, repr=False)
     identity_confidence: np.ndarray | None = field(default=None, repr=False)
+    face: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.fps = float(self.fps)
@@ -98,6 +105,7 @@ class KeypointTrack:
         n = self.times.shape[0] if self.times.ndim == 1 else 0
         ident = np.full(n, np.nan) if self.identity_confidence is None else self.identity_confidence
         self.identity_confidence = np.asarray(ident, dtype=float)
+        self.face = np.asarray(np.full(n, np.nan) if self.face is None else self.face, dtype=float)
         self.validate()
 
     def validate(self) -> None:
@@ -113,6 +121,7 @@ class KeypointTrack:
             "world": (t, k, 3),
             "crops": (t, 5),
             "identity_confidence": (t,),
+            "face": (t,),
         }
         for name, shape in expected.items():
             got = getattr(self, name).shape
@@ -123,12 +132,18 @@ class KeypointTrack:
         vis = self.visibility[np.isfinite(self.visibility)]
         if vis.size and (vis.min() < 0 or vis.max() > 1):
             raise KeypointError(f"keypoint track visibility outside [0, 1]: [{vis.min()}, {vis.max()}]")
-        ident = self.identity_confidence[np.isfinite(self.identity_confidence)]
-        if ident.size and (ident.min() < 0 or ident.max() > 1):
-            raise KeypointError(f"keypoint track identity_confidence outside [0, 1]: [{ident.min()}, {ident.max()}]")
+        for name in _OPTIONAL:
+            v = getattr(self, name)[np.isfinite(getattr(self, name))]
+            if v.size and (v.min() < 0 or v.max() > 1):
+                raise KeypointError(f"keypoint track {name} outside [0, 1]: [{v.min()}, {v.max()}]")
 
     def __len__(self) -> int:
         return int(self.times.shape[0])
+
+    def frames(self, index) -> KeypointTrack:
+        """The track cut to `index` (a slice or frame indices) along time."""
+        per_frame = ("times", "xy", "visibility", "presence", "world", "crops") + _OPTIONAL
+        return replace(self, **{name: np.asarray(getattr(self, name))[index] for name in per_frame})
 
     @classmethod
     def empty(cls, n_frames: int, fps: float, image_size, backend: str, times=None) -> KeypointTrack:
@@ -153,7 +168,8 @@ class KeypointTrack:
         arrays = {name: getattr(self, name) for name in _FIELDS}
         arrays["backend"] = np.array(self.backend)
         arrays["names"] = np.array(self.names)
-        arrays["identity_confidence"] = self.identity_confidence
+        for name in _OPTIONAL:
+            arrays[name] = getattr(self, name)
         with (
             atomic_path(path, suffix=".npz") as tmp,
             open(tmp, "wb") as f,
@@ -178,8 +194,7 @@ class KeypointTrack:
                     raise KeypointError(f"{path}: not a keypoint track, missing fields {missing}")
                 values = {f: data[f] for f in _FIELDS}
                 names = tuple(str(n) for n in data["names"]) if "names" in data.files else LANDMARK_NAMES
-                if "identity_confidence" in data.files:
-                    values["identity_confidence"] = data["identity_confidence"]
+                values.update({f: data[f] for f in _OPTIONAL if f in data.files})
         except (OSError, ValueError) as exc:
             raise KeypointError(f"{path}: cannot read keypoint track: {exc}") from exc
         values["fps"] = float(values["fps"])

@@ -21,14 +21,24 @@ depth (the yaw θ, 0 facing the camera, +90° facing the image's right):
   (:data:`DROP_SD`, :data:`DROP_OUTLIER_RATE`, :data:`DROP_WEIGHT`);
   a stretch of frames decides.
 
+* **a face in the image** (:mod:`.face`): a face detector on the head
+  finds one in about half the frames of a body facing the camera and in
+  none of a body seen from behind, whatever the pose model drew there.  Its
+  rate facing the camera depends on the video (resolution, light, the
+  person), so it is measured on each clip: the yaw is decoded once with the
+  rate of the development renders, the clip's rate read from the frames so
+  decoded as facing the camera, and the yaw decoded again with it (:data:`FACE_SEEN_SHARE`,
+  :data:`FACE_FALSE_RATE`, :data:`FACE_CORRELATION_S`); a clip whose faces
+  are too small to find (:data:`MIN_FACE_RATE`) is decoded without it.
+
 The feet's sideways cue cannot tell a turn from its mirror image (θ and
 180° − θ give the same sin θ, turning the other way); the shoulders' and
 hips' order can, but only as right as the left/right labels: where the
 identity decoder left them swapped, the order cue is mirrored for a stretch
 (on development renders, 13.5 % of the frames away from side views, in
 stretches of 1.3 s frame-weighted mean).  The feet's drop does not depend
-on the labels: it is what tells a back view the pose model drew as a front
-view from a front view.
+on the labels, nor does the face: they are what tells a back view the pose
+model drew as a front view from a front view.
 
 :func:`decode_yaw` models that directly.  The hidden state is yaw
 (:data:`YAW_STEP_DEG` grid) × yaw rate (up to :data:`MAX_RATE_DEG_S`,
@@ -65,10 +75,17 @@ __all__ = [
     "DROP_OUTLIER_RATE",
     "DROP_SD",
     "DROP_WEIGHT",
+    "FACE_CORRELATION_S",
+    "FACE_FALSE_RATE",
+    "FACE_RATE_PRIOR_READINGS",
+    "FACE_RATE_RENDERS",
+    "FACE_SEEN_SHARE",
+    "FACE_SEEN_YAW_DEG",
     "FEET_FACING_DROP",
     "FEET_SIDE_ON",
     "MARGIN_S",
     "MAX_RATE_DEG_S",
+    "MIN_FACE_RATE",
     "MIN_FEET_SEEN",
     "MIRRORED_MEAN_S",
     "MIRRORED_SHARE",
@@ -148,6 +165,31 @@ DROP_OUTLIER_RATE = 0.3
 #: of a frame, not a time: weighted per second instead, at 5 fps the drop
 #: outvoted the other cues and swapped a whole body for 14 frames.
 DROP_WEIGHT = 0.2
+#: How often the face detector finds a face, by the body's yaw away from
+#: facing the camera (degrees), as a share of its rate facing the camera:
+#: turning renders through BlazePose, both development sets, 0.45 of frames
+#: within 60° of facing, 0.27–0.33 at 60–75°, 0.07–0.12 side-on, 0.02–0.09
+#: at 105–120° and none further round (it needs the eyes).
+FACE_SEEN_YAW_DEG = (0.0, 55.0, 68.0, 82.0, 98.0, 112.0, 125.0, 180.0)
+FACE_SEEN_SHARE = (1.0, 1.0, 0.6, 0.2, 0.17, 0.1, 0.0, 0.0)
+#: Probability of a face found where none faces the camera (the profile
+#: cascade on hair or a raised arm): 0–2 % of frames with the back turned.
+FACE_FALSE_RATE = 0.02
+#: How long the detector's misses last, seconds: a bowed head or an arm
+#: across the face holds for a pose, so a frame counts for this share of an
+#: independent reading.  Chosen so a whole second facing the camera without
+#: a face found is as rare as measured: 10 % and 19 % of such seconds on the
+#: two development sets, against 88–99 % of seconds with the back turned.
+FACE_CORRELATION_S = 0.3
+#: A clip whose faces are found in fewer of its frames facing the camera
+#: than this does not resolve faces (too small, too dark, turned away all
+#: along); its misses say nothing of the view and the cue is not used.
+MIN_FACE_RATE = 0.1
+#: Rate of faces found facing the camera on the development renders: the
+#: first decoding's, and the prior of a clip's own, which counts as this
+#: many independent readings (:data:`FACE_CORRELATION_S`) beside the clip's.
+FACE_RATE_RENDERS = 0.45
+FACE_RATE_PRIOR_READINGS = 2.0
 #: Frames are decoded in windows of this many seconds, each with this much
 #: context either side (a turn's evidence reaches a few seconds at most).
 WINDOW_S = 60.0
@@ -222,6 +264,35 @@ class _Lattice:
             * _cue_likelihood(drop, np.maximum(c, 0.0), DROP_SD, DROP_OUTLIER_RATE) ** DROP_WEIGHT
         )
         return np.stack([lf * _cue_likelihood(width, c), lf * _cue_likelihood(width, -c)], axis=-1)
+
+    def face_weight(self, face: np.ndarray) -> float:
+        """Share of a reading one assessed frame of `face` counts for (:data:`FACE_CORRELATION_S`)."""
+        per_second = max(np.isfinite(face).mean(), 1.0 / max(face.size, 1)) * self.fps
+        return min(1.0, 1.0 / (FACE_CORRELATION_S * per_second))
+
+    def face_likelihood(self, face: np.ndarray, rate: float) -> np.ndarray:
+        """(T, N) likelihood of each frame's face found (1) or not (0) for each yaw (1 where NaN).
+
+        `rate` is the clip's rate of faces found facing the camera.
+        """
+        away = np.degrees(np.abs(np.angle(np.exp(1j * np.radians(self.grid)))))
+        p = FACE_FALSE_RATE + (rate - FACE_FALSE_RATE) * np.interp(away, FACE_SEEN_YAW_DEG, FACE_SEEN_SHARE)
+        lik = np.where(face[:, None] > 0.5, p[None], 1.0 - p[None])
+        return np.where(np.isfinite(face)[:, None], lik ** self.face_weight(face), 1.0)
+
+    def face_rate(self, face: np.ndarray, yaw: np.ndarray) -> float | None:
+        """The clip's rate of faces found where yaw bins `yaw` face the camera, or None if too low to use.
+
+        Faces found within 45° of facing, as independent readings
+        (:meth:`face_weight`), beside :data:`FACE_RATE_PRIOR_READINGS` at
+        the renders' rate; None below :data:`MIN_FACE_RATE`.
+        """
+        away = np.abs(np.angle(np.exp(1j * np.radians(self.grid[yaw]))))
+        seen = face[(away < np.pi / 4) & np.isfinite(face)]
+        readings = seen.size * self.face_weight(face)
+        found = seen.sum() * self.face_weight(face)
+        rate = (found + FACE_RATE_RENDERS * FACE_RATE_PRIOR_READINGS) / (readings + FACE_RATE_PRIOR_READINGS)
+        return float(rate) if rate >= MIN_FACE_RATE else None
 
     def _rate_mix(self, a: np.ndarray) -> np.ndarray:
         """Sum over the previous rate (the rate-change kernel is symmetric: its own transpose)."""
@@ -378,6 +449,16 @@ class YawDecoding:
     mirrored: np.ndarray
 
 
+def _face_per_kept_frame(face: np.ndarray, stride: int) -> np.ndarray:
+    """The face cue of every `stride`-th frame: found if found in any frame up to the next, NaN if none looked."""
+    T = face.size
+    blocks = np.full(((T + stride - 1) // stride) * stride, np.nan)
+    blocks[:T] = face
+    blocks = blocks.reshape(-1, stride)
+    looked = np.isfinite(blocks).any(axis=1)
+    return np.where(looked, np.nanmax(np.where(looked[:, None], blocks, 0.0), axis=1), np.nan)
+
+
 def decode_yaw(track: KeypointTrack) -> np.ndarray:
     """The body's yaw towards the camera in every frame, unwrapped over the clip.
 
@@ -416,7 +497,18 @@ def yaw_decoding(track: KeypointTrack) -> YawDecoding:
     stride = max(1, int(round(float(track.fps) / DECODE_FPS)))
     keep = np.arange(0, T, stride)
     lat = _Lattice(float(track.fps) / stride)
-    yaw_i, rate_i, yaw_posterior, mirrored = _posterior_path(lat, lat.emission(feet[keep], width[keep], drop[keep]))
+    emit = lat.emission(feet[keep], width[keep], drop[keep])
+    face = _face_per_kept_frame(np.asarray(track.face, float), stride)
+    if np.isfinite(face).any():
+        # The clip's own rate of faces found facing the camera, read where
+        # a decoding at the development sets' rate faces it (decoded without
+        # the cue, a long back view drawn as a front view would count as
+        # facing without a face and hide the cue that tells it).
+        first = _posterior_path(lat, emit * lat.face_likelihood(face, FACE_RATE_RENDERS)[:, :, None])[0]
+        face_rate = lat.face_rate(face, first)
+        if face_rate is not None:
+            emit = emit * lat.face_likelihood(face, face_rate)[:, :, None]
+    yaw_i, rate_i, yaw_posterior, mirrored = _posterior_path(lat, emit)
     readings = _readings(lat, yaw_i, yaw_posterior)
     unwrapped = lat.grid[yaw_i[0]] + np.r_[0.0, np.cumsum(lat.rates[rate_i[1:]] * YAW_STEP_DEG)]
     frames = np.arange(T)

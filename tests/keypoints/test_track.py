@@ -60,3 +60,29 @@ def test_landmark_index():
     assert landmark_index("left_wrist") == 15 and landmark_index("right_foot_index") == 32
     with pytest.raises(KeypointError, match="left_wirst"):
         landmark_index("left_wirst")
+
+
+def test_the_face_cue_round_trips_and_older_tracks_read_it_as_not_assessed(tmp_path):
+    from dataclasses import replace
+
+    tr = replace(_track(), face=np.array([np.nan, 1.0, 0.0, np.nan, 1.0]))
+    back = KeypointTrack.load(tr.save(tmp_path / "face.npz"))
+    np.testing.assert_array_equal(back.face, tr.face)
+    older = tmp_path / "older.npz"
+    with np.load(tmp_path / "face.npz") as data:
+        np.savez(older, **{k: data[k] for k in data.files if k not in ("face", "identity_confidence")})
+    old = KeypointTrack.load(older)
+    assert np.isnan(old.face).all() and np.isnan(old.identity_confidence).all()
+    with pytest.raises(KeypointError, match="face outside"):
+        replace(tr, face=np.full(5, 2.0))
+
+
+def test_frames_cuts_every_per_frame_field():
+    from dataclasses import replace
+
+    tr = replace(_track(), face=np.arange(5) / 4.0, identity_confidence=np.full(5, 0.5))
+    part = tr.frames(slice(1, 4))
+    assert len(part) == 3
+    for name in ("times", "xy", "visibility", "presence", "world", "crops", "face", "identity_confidence"):
+        np.testing.assert_array_equal(getattr(part, name), getattr(tr, name)[1:4])
+    assert part.fps == tr.fps and part.backend == tr.backend

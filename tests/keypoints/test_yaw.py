@@ -182,3 +182,48 @@ def test_a_full_turn_in_the_air_is_followed(seed):
     got = decode_yaw(track)
     assert abs((got[-1] - got[0]) - (truth[-1] - truth[0])) <= HALF_EIGHTH_DEG
     assert np.mean(_err(got, truth) <= HALF_EIGHTH_DEG) >= 0.95
+
+
+def _faces(truth: np.ndarray, rng: np.random.Generator, rate: float = 0.45) -> np.ndarray:
+    """A face detector's readings as measured on renders: found in `rate` of frames near facing, never from behind."""
+    share = np.interp(_err(truth, 0.0), yaw_module.FACE_SEEN_YAW_DEG, yaw_module.FACE_SEEN_SHARE)
+    return (rng.random(truth.size) < rate * share).astype(float)
+
+
+@pytest.mark.parametrize("seed", [521, 527])
+def test_a_back_view_drawn_as_a_front_view_is_read_from_the_face(seed, monkeypatch):
+    # The back views drawn as front views, and the feet's drop no help
+    # (every frame an outlier): the order cue alone reads them as facing
+    # the camera.  A face found in about half the frames near facing the
+    # camera and never from behind decides.
+    monkeypatch.setattr(yaw_module, "DROP_OUTLIER_RATE", 1.0)
+    track, truth = _clip(seed)
+    back = _err(truth, 180.0) <= 45.0
+    track.xy[back] = track.xy[back][:, MIRROR]
+    assert np.mean(_err(decode_yaw(track), truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
+    faces = _faces(truth, np.random.default_rng(seed))
+    got = decode_yaw(replace(track, face=faces))
+    assert np.mean(_err(got, truth)[back] <= HALF_EIGHTH_DEG) >= 0.9
+    assert np.mean(_err(got, truth) <= HALF_EIGHTH_DEG) >= 0.9
+
+
+def test_a_clip_whose_faces_are_never_found_decodes_as_without_the_cue():
+    # Faces too small or too dark to find: no frame facing the camera shows
+    # one, so the misses say nothing of the view.
+    track, _ = _clip(2, turns=False)
+    np.testing.assert_array_equal(decode_yaw(replace(track, face=np.zeros(len(track)))), decode_yaw(track))
+
+
+def test_faces_looked_for_every_other_frame_count_as_much_as_every_frame():
+    # The cue's weight is per second, not per frame looked at (the misses
+    # last about as long either way).
+    lat = yaw_module._Lattice(25.0)
+    every = np.ones(100)
+    other = every.copy()
+    other[1::2] = np.nan
+    assert lat.face_weight(other) == pytest.approx(2.0 * lat.face_weight(every))
+    one = lat.face_likelihood(every[:1], 0.45)
+    assert one[0, 0] > one[0, lat.N // 2]  # a face: facing the camera, not the back
+    none = lat.face_likelihood(np.zeros(1), 0.45)
+    assert none[0, 0] < none[0, lat.N // 2]
+    np.testing.assert_array_equal(lat.face_likelihood(np.array([np.nan]), 0.45), 1.0)
