@@ -5,17 +5,17 @@ face landmarks sit on the back of the head, its left and right are
 exchanged, and the feet and the depth order follow that reading.  What it
 does not do is make a face appear in the pixels.  A face detector run on
 the head says what the image itself shows: on BlazePose's head region of
-turning renders it finds a face (frontal or profile) in about half the
-frames with the body within 30° of facing the camera, about 40 % between
-30° and 60°, 7–10 % side-on, and none in over 1,000 frames with the back
-within 60° of the camera (a few percent of profile false alarms on one of
-two development sets; ``docs/benchmarks.md``, fifteenth session).
+turning renders it finds a face (frontal or profile) in 42–51 % of the
+frames with the body within 30° of facing the camera, 39–43 % between 30°
+and 60°, 7–16 % side-on, and in 0–1 % of 1,443 frames with the back
+within 60° of the camera (two development sets; ``docs/benchmarks.md``,
+fifteenth session).
 
 The detector is OpenCV's Viola–Jones cascades that ship with OpenCV
 (frontal face and profile face, the profile one run on the image and on its
 mirror image, as it finds faces turned one way only), run on a square crop
-about the head scaled so a face is 20–70 px, whatever the person's size in
-the frame.  :func:`face_seen` gives 1 (a face), 0 (none) or NaN (no person
+about the head scaled by the torso, so a face has the same size in it
+whatever the person's size in the frame.  :func:`face_seen` gives 1 (a face), 0 (none) or NaN (no person
 or no head and torso landmarks to place the crop).
 """
 
@@ -26,21 +26,25 @@ import numpy as np
 
 __all__ = ["CROP_PX", "CROP_TORSO_LENGTHS", "FACE_EVERY_S", "FaceDetector", "face_seen", "head_crop"]
 
-#: A face is looked for every this many seconds (every other frame at
+#: A face is looked for every this many seconds (every third frame at
 #: 25 fps): its misses last about 0.3 s (:data:`~.yaw.FACE_CORRELATION_S`),
-#: so looking in every frame would cost twice the time for little more.
-FACE_EVERY_S = 0.08
+#: and looking every frame, every other or every third frame read the yaw
+#: equally well on the development renders (96.9 / 96.9 / 96.9 % and
+#: 96.8 / 96.6 / 96.8 % of frames within 22.5°) at up to three times the cost.
+FACE_EVERY_S = 0.12
 
 #: Side of the square head crop, pixels, and its side in torso lengths
 #: (shoulders' middle to hips' middle in the image): a head is about half
-#: a torso length tall, so its face spans 25–45 px of the crop, inside the
-#: cascades' 20–72 px search.
+#: a torso length tall, so the cascades' face box spans 30–65 px of the
+#: crop, inside the search (:data:`_MIN_FACE_PX`–:data:`_MAX_FACE_PX`).
 CROP_PX = 96
 CROP_TORSO_LENGTHS = 1.0
-#: Search sizes, pixels of the crop: a face smaller than the frontal
-#: cascade's 20-px window is not resolved; one larger than three quarters
-#: of the crop is not a face at the head.
-_MIN_FACE_PX = 20
+#: Search sizes, pixels of the crop.  Faces are found at 30–44 px on a real
+#: person (the squat video of the fixtures) and 42–65 px on the renders'
+#: mannequin; below 28 px the search costs most (the smallest windows are
+#: the most numerous) and found no more (5 ms a look from 20 px, 3.3 ms from
+#: 28 px); one larger than three quarters of the crop is not a face at the head.
+_MIN_FACE_PX = 28
 _MAX_FACE_PX = 72
 #: Detector settings: OpenCV's defaults (scale step 1.1, three overlapping
 #: detections to accept one).

@@ -169,7 +169,7 @@ DROP_WEIGHT = 0.2
 #: facing the camera (degrees), as a share of its rate facing the camera:
 #: turning renders through BlazePose, both development sets, 0.45 of frames
 #: within 60° of facing, 0.27–0.33 at 60–75°, 0.07–0.12 side-on, 0.02–0.09
-#: at 105–120° and none further round (it needs the eyes).
+#: at 105–120° and 0–1 % further round (it needs the eyes).
 FACE_SEEN_YAW_DEG = (0.0, 55.0, 68.0, 82.0, 98.0, 112.0, 125.0, 180.0)
 FACE_SEEN_SHARE = (1.0, 1.0, 0.6, 0.2, 0.17, 0.1, 0.0, 0.0)
 #: Probability of a face found where none faces the camera (the profile
