@@ -78,3 +78,20 @@ def test_a_head_at_the_image_edge_is_cropped_without_error(where):
     xy[11:13] = (x, y + 40.0)
     xy[23:25] = (x, y + 120.0)
     assert FaceDetector()(image, xy) == 0.0
+
+
+@pytest.mark.model
+def test_extract_looks_for_a_face_every_few_frames(blazepose, demo_pose):
+    from capture2notation.keypoints import extract_frames
+    from capture2notation.keypoints.face import FACE_EVERY_S
+    from synthetic import render
+
+    pose = demo_pose(12, 25.0)
+    cam = render.Camera.for_view("front", (640, 480), pose.body.height)
+    track = extract_frames(render.render_frames(pose, cam, "mannequin"), pose.fps, estimator=blazepose)
+    looked = np.flatnonzero(np.isfinite(track.face))
+    # Every FACE_EVERY_S from the first frame (every third at 25 fps).
+    np.testing.assert_array_equal(looked, np.arange(0, 12, int(round(FACE_EVERY_S * 25.0))))
+    assert np.mean(track.face[looked]) >= 0.5  # the mannequin faces the camera
+    off = extract_frames(render.render_frames(pose, cam, "mannequin"), pose.fps, estimator=blazepose, faces=False)
+    assert np.isnan(off.face).all()
