@@ -190,21 +190,34 @@ def _faces(truth: np.ndarray, rng: np.random.Generator, rate: float = 0.45) -> n
     return (rng.random(truth.size) < rate * share).astype(float)
 
 
-@pytest.mark.parametrize("seed", [521, 527])
-def test_a_back_view_drawn_as_a_front_view_is_read_from_the_face(seed, monkeypatch):
+#: The draws from 500-559 with a second or more of back views that the order
+#: cue alone (no feet's drop) reads as facing the camera.
+_BACK_VIEWS_LOST = (500, 519, 521, 527, 530, 537, 541, 547, 552)
+
+
+def test_back_views_drawn_as_front_views_are_read_from_the_face(monkeypatch):
     # The back views drawn as front views, and the feet's drop no help
     # (every frame an outlier): the order cue alone reads them as facing
     # the camera.  A face found in about half the frames near facing the
-    # camera and never from behind decides.
+    # camera and never from behind decides, where the clip faces the camera
+    # long enough to measure its rate of faces: not in 527 and 537 (0.5 and
+    # 0.6 s facing it, under the prior's two readings), which keep the
+    # decoding without the cue.
     monkeypatch.setattr(yaw_module, "DROP_OUTLIER_RATE", 1.0)
-    track, truth = _clip(seed)
-    back = _err(truth, 180.0) <= 45.0
-    track.xy[back] = track.xy[back][:, MIRROR]
-    assert np.mean(_err(decode_yaw(track), truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
-    faces = _faces(truth, np.random.default_rng(seed))
-    got = decode_yaw(replace(track, face=faces))
-    assert np.mean(_err(got, truth)[back] <= HALF_EIGHTH_DEG) >= 0.9
-    assert np.mean(_err(got, truth) <= HALF_EIGHTH_DEG) >= 0.9
+    unused, read = [], []
+    for seed in _BACK_VIEWS_LOST:
+        track, truth = _clip(seed)
+        back = _err(truth, 180.0) <= 45.0
+        track.xy[back] = track.xy[back][:, MIRROR]
+        before = decode_yaw(track)
+        assert np.mean(_err(before, truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
+        got = decode_yaw(replace(track, face=_faces(truth, np.random.default_rng(seed))))
+        if np.array_equal(got, before, equal_nan=True):
+            unused.append(seed)
+        else:
+            read.append(np.mean(_err(got, truth)[back] <= HALF_EIGHTH_DEG) >= 0.9)
+    assert unused == [527, 537]
+    assert len(read) == 7 and all(read)
 
 
 def test_a_clip_whose_faces_are_never_found_decodes_as_without_the_cue():
