@@ -188,11 +188,10 @@ MIN_FACE_RATE = 0.1
 #: Rate of faces found facing the camera on the development renders: the
 #: first decoding's, and the prior of a clip's own, which counts as this
 #: many independent readings (:data:`FACE_CORRELATION_S`) beside the clip's.
-#: A clip whose own readings facing the camera weigh less than the prior
-#: has no rate of its own and the cue is not used: a profile held for a
-#: whole clip otherwise drifts, frame after frame of misses, from side-on
-#: towards the back (the built-in phrases filmed side-on, no frame facing
-#: the camera: knees and ankles swapped in 7 of 218 frames).
+#: A clip with no frame facing the camera has no rate of its own and the
+#: cue is not used: a profile held for a whole clip otherwise drifts, frame
+#: after frame of misses, from side-on towards the back (the built-in
+#: phrases filmed side-on: knees and ankles swapped in 7 of 218 frames).
 FACE_RATE_RENDERS = 0.45
 FACE_RATE_PRIOR_READINGS = 2.0
 #: Frames are decoded in windows of this many seconds, each with this much
@@ -290,14 +289,14 @@ class _Lattice:
 
         Faces found within 45° of facing, as independent readings
         (:meth:`face_weight`), beside :data:`FACE_RATE_PRIOR_READINGS` at
-        the renders' rate; None below :data:`MIN_FACE_RATE` or where the
-        clip's readings facing the camera weigh less than the prior's.
+        the renders' rate; None below :data:`MIN_FACE_RATE` or where no
+        frame faces the camera.
         """
         away = np.abs(np.angle(np.exp(1j * np.radians(self.grid[yaw]))))
         seen = face[(away < np.pi / 4) & np.isfinite(face)]
-        readings = seen.size * self.face_weight(face)
-        if readings < FACE_RATE_PRIOR_READINGS:
+        if seen.size == 0:
             return None
+        readings = seen.size * self.face_weight(face)
         found = seen.sum() * self.face_weight(face)
         rate = (found + FACE_RATE_RENDERS * FACE_RATE_PRIOR_READINGS) / (readings + FACE_RATE_PRIOR_READINGS)
         return float(rate) if rate >= MIN_FACE_RATE else None

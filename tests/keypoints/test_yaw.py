@@ -199,25 +199,34 @@ def test_back_views_drawn_as_front_views_are_read_from_the_face(monkeypatch):
     # The back views drawn as front views, and the feet's drop no help
     # (every frame an outlier): the order cue alone reads them as facing
     # the camera.  A face found in about half the frames near facing the
-    # camera and never from behind decides, where the clip faces the camera
-    # long enough to measure its rate of faces: not in 527 and 537 (0.5 and
-    # 0.6 s facing it, under the prior's two readings), which keep the
-    # decoding without the cue.
+    # camera and never from behind decides in seven of the nine; 527 and
+    # 537 face the camera for only 0.5 and 0.6 s, too little for the clip's
+    # rate of faces to outweigh the order cue.
     monkeypatch.setattr(yaw_module, "DROP_OUTLIER_RATE", 1.0)
-    unused, read = [], []
+    read = []
     for seed in _BACK_VIEWS_LOST:
         track, truth = _clip(seed)
         back = _err(truth, 180.0) <= 45.0
         track.xy[back] = track.xy[back][:, MIRROR]
-        before = decode_yaw(track)
-        assert np.mean(_err(before, truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
+        assert np.mean(_err(decode_yaw(track), truth)[back] <= HALF_EIGHTH_DEG) <= 0.5
         got = decode_yaw(replace(track, face=_faces(truth, np.random.default_rng(seed))))
-        if np.array_equal(got, before, equal_nan=True):
-            unused.append(seed)
-        else:
-            read.append(np.mean(_err(got, truth)[back] <= HALF_EIGHTH_DEG) >= 0.9)
-    assert unused == [527, 537]
-    assert len(read) == 7 and all(read)
+        read.append(np.mean(_err(got, truth)[back] <= HALF_EIGHTH_DEG) >= 0.9)
+    assert sum(read) >= 7
+
+
+def test_the_clips_rate_of_faces_is_read_where_it_faces_the_camera():
+    lat = yaw_module._Lattice(25.0)
+    side = np.full(100, lat.N // 4)  # 90°: side-on throughout
+    facing = np.zeros(100, int)
+    faces = (np.arange(100) % 4 == 0).astype(float)  # a face in a quarter of the frames
+    # A profile held throughout has no rate of its own: misses frame after
+    # frame would otherwise pull the yaw from side-on towards the back.
+    assert lat.face_rate(faces, side) is None
+    # Facing the camera for 4 s (13 readings) beside the prior's two at 0.45.
+    expected = (0.25 * 100 * lat.face_weight(faces) + 0.45 * 2.0) / (100 * lat.face_weight(faces) + 2.0)
+    assert lat.face_rate(faces, facing) == pytest.approx(expected)
+    # No face in 4 s facing the camera: faces this video does not resolve.
+    assert lat.face_rate(np.zeros(100), facing) is None
 
 
 def test_a_clip_whose_faces_are_never_found_decodes_as_without_the_cue():
