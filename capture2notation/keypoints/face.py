@@ -15,8 +15,9 @@ The detector is OpenCV's Viola–Jones cascades that ship with OpenCV
 (frontal face and profile face, the profile one run on the image and on its
 mirror image, as it finds faces turned one way only), run on a square crop
 about the head scaled by the torso, so a face has the same size in it
-whatever the person's size in the frame.  :func:`face_seen` gives 1 (a face), 0 (none) or NaN (no person
-or no head and torso landmarks to place the crop).
+whatever the person's size in the frame.  :class:`FaceDetector` gives 1 (a
+face), 0 (none) or NaN (no person, or no head and torso landmarks to place
+the crop).
 """
 
 from __future__ import annotations
@@ -24,7 +25,9 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-__all__ = ["CROP_PX", "CROP_TORSO_LENGTHS", "FACE_EVERY_S", "FaceDetector", "face_seen", "head_crop"]
+from .identity import torso_and_order
+
+__all__ = ["CROP_PX", "CROP_TORSO_LENGTHS", "FACE_EVERY_S", "FaceDetector", "head_crop"]
 
 #: A face is looked for every this many seconds (every third frame at
 #: 25 fps): its misses last about 0.3 s (:data:`~.yaw.FACE_CORRELATION_S`),
@@ -50,9 +53,8 @@ _MAX_FACE_PX = 72
 #: detections to accept one).
 _SCALE_STEP = 1.1
 _MIN_NEIGHBOURS = 3
-#: Landmarks of the head (nose, eyes, ears, mouth) and of the torso.
+#: Landmarks of the head (nose, eyes, ears, mouth).
 _HEAD = slice(0, 11)
-_SHOULDERS, _HIPS = (11, 12), (23, 24)
 
 
 class FaceDetector:
@@ -106,7 +108,7 @@ def head_crop(image: np.ndarray, xy: np.ndarray) -> np.ndarray | None:
     xy = np.asarray(xy, float)[:, :2]
     head = xy[_HEAD]
     head = head[np.isfinite(head).all(axis=1)]
-    torso = np.linalg.norm(xy[list(_SHOULDERS)].mean(axis=0) - xy[list(_HIPS)].mean(axis=0))
+    torso = torso_and_order(xy[None])[0][0]
     if head.shape[0] == 0 or not np.isfinite(torso) or torso <= 1.0:
         return None
     grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
@@ -114,8 +116,3 @@ def head_crop(image: np.ndarray, xy: np.ndarray) -> np.ndarray | None:
     scale = CROP_PX / (CROP_TORSO_LENGTHS * torso)
     warp = np.array([[scale, 0.0, CROP_PX / 2 - cx * scale], [0.0, scale, CROP_PX / 2 - cy * scale]])
     return cv2.warpAffine(grey, warp, (CROP_PX, CROP_PX), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-
-
-def face_seen(image: np.ndarray, xy: np.ndarray, detector: FaceDetector | None = None) -> float:
-    """:class:`FaceDetector` on one frame (a new detector unless one is given)."""
-    return (detector or FaceDetector())(image, xy)

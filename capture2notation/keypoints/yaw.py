@@ -29,7 +29,8 @@ depth (the yaw θ, 0 facing the camera, +90° facing the image's right):
   rate of the development renders, the clip's rate read from the frames so
   decoded as facing the camera, and the yaw decoded again with it (:data:`FACE_SEEN_SHARE`,
   :data:`FACE_FALSE_RATE`, :data:`FACE_CORRELATION_S`); a clip whose faces
-  are too small to find (:data:`MIN_FACE_RATE`) is decoded without it.
+  are too small to find (:data:`MIN_FACE_RATE`), or that never faces the
+  camera, is decoded without it.
 
 The feet's sideways cue cannot tell a turn from its mirror image (θ and
 180° − θ give the same sin θ, turning the other way); the shoulders' and
@@ -229,6 +230,8 @@ class _Lattice:
         self.fps = fps
         self.grid = np.arange(0.0, 360.0, YAW_STEP_DEG)
         self.N = self.grid.size
+        # Each bin's angle from facing the camera, degrees in [0, 180].
+        self.away = np.degrees(np.abs(np.angle(np.exp(1j * np.radians(self.grid)))))
         k_max = max(1, int(round(MAX_RATE_DEG_S / fps / YAW_STEP_DEG)))
         # Below half a turn a frame: a faster rate is a slower one the other way.
         k_max = min(k_max, self.N // 2 - 1)
@@ -279,8 +282,7 @@ class _Lattice:
 
         `rate` is the clip's rate of faces found facing the camera.
         """
-        away = np.degrees(np.abs(np.angle(np.exp(1j * np.radians(self.grid)))))
-        p = FACE_FALSE_RATE + (rate - FACE_FALSE_RATE) * np.interp(away, FACE_SEEN_YAW_DEG, FACE_SEEN_SHARE)
+        p = FACE_FALSE_RATE + (rate - FACE_FALSE_RATE) * np.interp(self.away, FACE_SEEN_YAW_DEG, FACE_SEEN_SHARE)
         lik = np.where(face[:, None] > 0.5, p[None], 1.0 - p[None])
         return np.where(np.isfinite(face)[:, None], lik ** self.face_weight(face), 1.0)
 
@@ -292,12 +294,11 @@ class _Lattice:
         the renders' rate; None below :data:`MIN_FACE_RATE` or where no
         frame faces the camera.
         """
-        away = np.abs(np.angle(np.exp(1j * np.radians(self.grid[yaw]))))
-        seen = face[(away < np.pi / 4) & np.isfinite(face)]
+        seen = face[(self.away[yaw] < 45.0) & np.isfinite(face)]
         if seen.size == 0:
             return None
-        readings = seen.size * self.face_weight(face)
-        found = seen.sum() * self.face_weight(face)
+        weight = self.face_weight(face)
+        readings, found = seen.size * weight, seen.sum() * weight
         rate = (found + FACE_RATE_RENDERS * FACE_RATE_PRIOR_READINGS) / (readings + FACE_RATE_PRIOR_READINGS)
         return float(rate) if rate >= MIN_FACE_RATE else None
 
