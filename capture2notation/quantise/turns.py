@@ -154,8 +154,12 @@ def turn_movements(
     window = max(1, int(round(_HELD_S * fps))) if measured else 1
     noise = FEET_HEADING_SD_DEG if measured else 0.0
     out = []
-    for a, b, eighths in spans:
-        if eighths == 0 or not _feet_turn_too(feet, a, b, EIGHTH_DEG * eighths, window, noise):
+    for k, (a, b, eighths) in enumerate(spans):
+        # The feet are read no further than the turns either side: a turn
+        # that meets its neighbour starts where the feet are still turning.
+        lo = spans[k - 1][1] if k > 0 else 0
+        hi = spans[k + 1][0] if k + 1 < len(spans) else T - 1
+        if eighths == 0 or not _feet_turn_too(feet, a, b, EIGHTH_DEG * eighths, window, noise, lo, hi):
             continue
         out.append(
             Movement(
@@ -325,17 +329,27 @@ def _feet_heading(joints: np.ndarray) -> np.ndarray:
     return out
 
 
-def _feet_turn_too(feet: np.ndarray, a: int, b: int, delta: float, window: int = 1, noise: float = 0.0) -> bool:
+def _feet_turn_too(
+    feet: np.ndarray,
+    a: int,
+    b: int,
+    delta: float,
+    window: int = 1,
+    noise: float = 0.0,
+    lo: int = 0,
+    hi: int | None = None,
+) -> bool:
     """Whether a foot turns with the hips between frames a and b (by :data:`FEET_TURN_FRACTION` of `delta`).
 
     A turn is the whole body's: the supporting foot pivots (or the feet turn
     in the air).  Hips that twist over planted feet turn neither.  Each
-    foot's heading is its median over `window` frames up to `a` and from
-    `b`, and may fall short by `noise` degrees (measured feet).  Feet not
-    measured: no veto.
+    foot's heading is its median over `window` frames up to `a` (from
+    frame `lo` on) and from `b` (up to frame `hi`), and may fall short by
+    `noise` degrees (measured feet).  Feet not measured: no veto.
     """
-    before = np.nanmedian(feet[max(0, a - window + 1) : a + 1], axis=0)
-    after = np.nanmedian(feet[b : b + window], axis=0)
+    hi = feet.shape[0] - 1 if hi is None else hi
+    before = np.nanmedian(feet[max(min(lo, a), a - window + 1) : a + 1], axis=0)
+    after = np.nanmedian(feet[b : max(b, min(b + window - 1, hi)) + 1], axis=0)
     d = after - before
     if not np.isfinite(d).any():
         return True

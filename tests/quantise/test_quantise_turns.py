@@ -249,3 +249,19 @@ def test_a_slow_measured_eighth_turn_is_written(seed):
     joints = interpret(_turn_score([(1, 4, "left", "1/8")]), fps=FPS).joints()
     got = turn_movements(joints + rng.normal(0.0, 0.01, joints.shape), FPS, measured=True)
     assert [(m.direction, m.amount) for m in got] == [("left", Fraction(1, 8))]
+
+
+def test_feet_are_read_no_further_back_than_the_turn_before():
+    """A turn that meets the one before starts where the feet are still
+    turning: read from there, an eighth right straight after a turn left
+    looks as if the feet turned the other way; read from where the turn
+    before arrives, they turned with the hips."""
+    from capture2notation.quantise.turns import _feet_turn_too
+
+    heading = np.r_[np.linspace(300.0, 0.0, 16), np.linspace(0.0, 45.0, 11)[1:], np.full(15, 45.0)]
+    feet = np.stack([heading, heading], axis=1)
+    a, b = 15, 25  # the eighth right: from the frame the turn left arrives to its own arrival
+    assert not _feet_turn_too(feet, a, b, 45.0, window=12, noise=8.0)
+    assert _feet_turn_too(feet, a, b, 45.0, window=12, noise=8.0, lo=15)
+    # Twisting hips over planted feet still do not turn.
+    assert not _feet_turn_too(np.zeros_like(feet), a, b, 45.0, window=12, noise=8.0, lo=15)
