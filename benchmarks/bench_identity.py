@@ -16,7 +16,10 @@ mannequin, the ``--view`` camera) of such scores through BlazePose: the
 frames with the right identity as BlazePose read them, after the decoder,
 after the feet's reading and after each arm and leg pair's side-on reading
 (:func:`capture2notation.keypoints.near_side.correct_near_side`; all as
-``extract`` applies them), scored against the renderer's keypoints.
+``extract`` applies them), scored against the renderer's keypoints, and
+the same for the shoulders and hips alone (the body's own left and right,
+each arm and leg apart).  With ``--back-turns DIR``, the issue's own case:
+six clips of slow turns on both feet through a back view, arms held.
 
 Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S] [--render DIR --renders N [--view V]]``
 """
@@ -24,6 +27,7 @@ Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--s
 from __future__ import annotations
 
 import argparse
+from fractions import Fraction
 
 import numpy as np
 
@@ -31,6 +35,7 @@ from capture2notation.body import Body
 from capture2notation.keypoints.identity import correct_identity
 from capture2notation.keypoints.near_side import correct_near_side
 from capture2notation.keypoints.yaw import correct_mirrored
+from capture2notation.notation.model import Score, Symbol
 from synthetic.identity_errors import facing_camera, truth_track, with_identity_errors
 from synthetic.interpret import interpret
 from synthetic.random_scores import random_score
@@ -74,6 +79,56 @@ def flips(facing: np.ndarray, keep: np.ndarray) -> int:
     return int(np.sum(f[1:] != f[:-1]))
 
 
+def _through_blazepose(score, out, view: str, fields, camera) -> tuple[np.ndarray, str]:
+    """Render `score` into `out`, read it with BlazePose and score each correction against the render.
+
+    Returns the clip's counts (frames; right identity as read, after
+    :func:`correct_identity`, :func:`correct_mirrored`,
+    :func:`correct_near_side`; decoded facing right and frames off side
+    views; shoulders and hips right as read and at the end) and its line.
+    """
+    from capture2notation.io.truth import read_truth
+    from capture2notation.keypoints import extract
+    from capture2notation.keypoints.evaluate import left_right_swaps, person_height_px
+    from synthetic.render.job import render_score
+
+    render = render_score(score, out, view=view, progress=False)
+    truth = read_truth(render / "truth.npz")
+    raw = extract(render / "video.mp4", identity=False, progress=False)
+    fixed, res = correct_identity(raw)
+    both, decoding = correct_mirrored(fixed)
+    limbs, _ = correct_near_side(both, decoding.yaw)
+    radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
+    swaps = [left_right_swaps(tr.xy, truth.keypoints, radius) for tr in (raw, fixed, both, limbs)]
+    wrong = [np.any(list(sw.values()), axis=0) for sw in swaps]
+    # The body's own left and right (shoulders and hips), apart from each arm's and leg's.
+    torso = [sw["shoulder"] | sw["hip"] for sw in swaps]
+    facing = facing_camera(fields["front"], camera.R)
+    off = off_side_views(fields["front"], camera.R)
+    face_ok = (res.facing == np.where(facing, 1, -1))[off]
+    line = (
+        f"({len(raw)} frames, {int((~facing).sum())} back to camera): right identity "
+        f"as read {1 - wrong[0].mean():.1%}, decoded {1 - wrong[1].mean():.1%}, then from the feet "
+        f"{1 - wrong[2].mean():.1%}, then side-on limbs {1 - wrong[3].mean():.1%} (shoulders and hips "
+        f"{1 - torso[0].mean():.1%} -> {1 - torso[3].mean():.1%}); decoded facing right "
+        f"{face_ok.mean():.1%} off side views; uncertain {res.uncertain.mean():.1%}"
+    )
+    counts = [len(raw), *((~w).sum() for w in wrong), face_ok.sum(), off.sum(), (~torso[0]).sum(), (~torso[3]).sum()]
+    return np.array(counts, float), line
+
+
+def _print_totals(label: str, done: int, tot: np.ndarray) -> None:
+    print(
+        f"{label} {done} clips, {int(tot[0])} frames: right identity as read {tot[1] / tot[0]:.1%}, "
+        f"decoded {tot[2] / tot[0]:.1%}, then from the feet {tot[3] / tot[0]:.1%}, "
+        f"then side-on limbs {tot[4] / tot[0]:.1%}; decoded facing right (off side views) {tot[5] / tot[6]:.1%}"
+    )
+    print(
+        f"{label} shoulders and hips (the body's own left and right, each arm and leg apart): right as read "
+        f"{tot[7] / tot[0]:.1%}, after every correction {tot[8] / tot[0]:.1%}"
+    )
+
+
 def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16, view: str = "front") -> None:
     """Renders of random scores with turns through BlazePose: identity as read and after each correction.
 
@@ -86,49 +141,62 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16, view: str =
     """
     from pathlib import Path
 
-    from capture2notation.io.truth import read_truth
-    from capture2notation.keypoints import extract
-    from capture2notation.keypoints.evaluate import left_right_swaps, person_height_px
-    from synthetic.render.job import render_score
-
-    tot = np.zeros(7)
+    tot = np.zeros(9)
     s, done = seed, 0
     while done < n_clips and s < seed + 40 * n_clips:
         score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
         pose = Pose.from_motion(interpret(score, 25.0, Body()))
         camera = Camera.for_view(view, (640, 480), pose.body.height)
         fields = truth_fields(pose, camera)
-        facing = facing_camera(fields["front"], camera.R)
         s += 1
-        if (~facing).sum() < 10:
+        if (~facing_camera(fields["front"], camera.R)).sum() < 10:
             continue
-        out = render_score(score, Path(outdir) / f"r{s - 1}", view=view, progress=False)
-        truth = read_truth(out / "truth.npz")
-        raw = extract(out / "video.mp4", identity=False, progress=False)
-        fixed, res = correct_identity(raw)
-        both, decoding = correct_mirrored(fixed)
-        limbs, _ = correct_near_side(both, decoding.yaw)
-        radius = 0.1 * person_height_px(truth.K, truth.R, truth.t, truth.root, truth.body_height)
-        wrong = [
-            np.any(list(left_right_swaps(tr.xy, truth.keypoints, radius).values()), axis=0)
-            for tr in (raw, fixed, both, limbs)
-        ]
-        off = off_side_views(fields["front"], camera.R)
-        face_ok = (res.facing == np.where(facing, 1, -1))[off]
-        print(
-            f"render seed {s - 1} ({len(raw)} frames, {int((~facing).sum())} back to camera): right identity "
-            f"as read {1 - wrong[0].mean():.1%}, decoded {1 - wrong[1].mean():.1%}, then from the feet "
-            f"{1 - wrong[2].mean():.1%}, then side-on limbs {1 - wrong[3].mean():.1%}; decoded facing right "
-            f"{face_ok.mean():.1%} off side views; uncertain {res.uncertain.mean():.1%}"
-        )
-        tot += [len(raw), *((~w).sum() for w in wrong), face_ok.sum(), off.sum()]
+        counts, line = _through_blazepose(score, Path(outdir) / f"r{s - 1}", view, fields, camera)
+        print(f"render seed {s - 1} {line}")
+        tot += counts
         done += 1
     if done:
-        print(
-            f"RENDERS {done} clips, {int(tot[0])} frames: right identity as read {tot[1] / tot[0]:.1%}, "
-            f"decoded {tot[2] / tot[0]:.1%}, then from the feet {tot[3] / tot[0]:.1%}, "
-            f"then side-on limbs {tot[4] / tot[0]:.1%}; decoded facing right (off side views) {tot[5] / tot[6]:.1%}"
-        )
+        _print_totals("RENDERS", done, tot)
+
+
+#: The issue's own case: a dancer turning slowly on both feet through a back
+#: view, arms held (the arms, the way and the tempo of each clip).
+BACK_TURN_ARMS = (
+    (("right", "middle"), ("left", "middle"), "right", 72),
+    (("forward", "high"), ("forward", "high"), "left", 90),
+    (("place", "low"), ("place", "low"), "right", 60),
+    (("right_forward", "middle"), ("left_back", "low"), "left", 108),
+    (("right_forward", "high"), ("left_forward", "high"), "right", 84),
+    (("right", "low"), ("left", "low"), "left", 66),
+)
+
+
+def back_turn_score(right_arm, left_arm, way: str, tempo: int) -> Score:
+    """Arms held, two quarter turns on both feet to the back, a hold there, two more round to the front."""
+    f = Fraction
+    syms = [
+        Symbol(f(0), f(1), "right_arm", *right_arm),
+        Symbol(f(0), f(1), "left_arm", *left_arm),
+        Symbol(f(0), f(1), "support", "place", "middle"),
+    ]
+    syms += [Symbol(f(start), f(2), "turn", way, None, amount=f(1, 4)) for start in (1, 3, 7, 9)]
+    syms += [Symbol(f(12), f(1), f"{side}_arm", "place", "low") for side in ("right", "left")]
+    return Score(symbols=tuple(syms), tempo=f(tempo), title="a turn through a back view")
+
+
+def back_turns(outdir, view: str = "front") -> None:
+    """The issue's case: slow turns on both feet through a back view (:data:`BACK_TURN_ARMS`), through BlazePose."""
+    from pathlib import Path
+
+    tot = np.zeros(9)
+    for i, (right_arm, left_arm, way, tempo) in enumerate(BACK_TURN_ARMS):
+        score = back_turn_score(right_arm, left_arm, way, tempo)
+        pose = Pose.from_motion(interpret(score, 25.0, Body()))
+        camera = Camera.for_view(view, (640, 480), pose.body.height)
+        counts, line = _through_blazepose(score, Path(outdir) / f"back{i}", view, truth_fields(pose, camera), camera)
+        print(f"turn through a back view {i} {line}")
+        tot += counts
+    _print_totals("BACK TURNS", len(BACK_TURN_ARMS), tot)
 
 
 def main(argv=None) -> None:
@@ -139,9 +207,14 @@ def main(argv=None) -> None:
     ap.add_argument("--renders", type=int, default=1, help="how many clips --render renders (from --seed on)")
     ap.add_argument("--view", default="front", choices=("front", "45", "side", "-45"), help="camera of --render")
     ap.add_argument("--clean", action="store_true", help="no errors put in (false corrections)")
+    ap.add_argument(
+        "--back-turns", metavar="DIR", help="also render slow turns on both feet through a back view into DIR"
+    )
     args = ap.parse_args(argv)
     if args.render:
         rendered(args.seed, args.render, args.renders, view=args.view)
+    if args.back_turns:
+        back_turns(args.back_turns, view=args.view)
     tot = {
         "n": 0,
         "before": 0,
