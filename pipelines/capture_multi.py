@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from capture2notation.errors import PipelineError
+from pipelines.capture_input import MOTION_SUFFIXES
 
 __all__ = ["MAX_AUTO_LAG_S", "ViewFiles", "check_views", "load_views", "parse_offsets"]
 
@@ -33,8 +34,6 @@ log = logging.getLogger(__name__)
 #: Largest start offset between clips searched by ``--offsets auto``, seconds
 #: (two phones started by hand within a couple of seconds of each other).
 MAX_AUTO_LAG_S = 2.0
-#: Inputs that are motion files, not clips (``pipelines.capture.MOTION_SUFFIXES``).
-_MOTION_SUFFIXES = (".bvh", ".csv", ".npz")
 #: Largest difference between two clips' frame rates taken as equal, fps
 #: (containers round 25 to 25.0000x).
 _FPS_TOL = 0.01
@@ -91,7 +90,7 @@ def check_views(videos, calibration, fps_override=None):
             raise PipelineError(f"{videos[i]}: camera {n!r} is given twice (also {videos[names.index(n)]})")
     cameras, infos = [], []
     for video, name in zip(videos, names):
-        if Path(video).suffix.lower() in _MOTION_SUFFIXES:
+        if Path(video).suffix.lower() in MOTION_SUFFIXES:
             raise PipelineError(f"{video}: a multi-camera capture takes video clips, not motion files")
         try:
             cam = cal[name]

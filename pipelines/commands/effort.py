@@ -69,7 +69,7 @@ def load_capture(path) -> dict:
         raise PipelineError(f"{path}: 'times' must have T = {t_count} entries, got {times.shape}")
     names = tuple(str(n) for n in data["joint_names"]) if "joint_names" in data else JOINTS
     if "input_kind" in data:
-        from pipelines.capture import is_fitted
+        from pipelines.capture_input import is_fitted
 
         fitted = is_fitted(str(data["input_kind"]))
     else:
