@@ -369,7 +369,8 @@ def notate(
         seg = replace(seg, tempo_source="no beat")
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
-    conf, readings = getattr(motion, "confidence", None), getattr(motion, "front_readings", None)
+    # A symbol rests on its joints measured and under their own labels.
+    conf, readings = _labelled_confidence(motion), getattr(motion, "front_readings", None)
     seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf, line_of_sight, readings))
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
@@ -490,7 +491,7 @@ def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = ""
         "joints": np.asarray(motion.joints, float),
         "angles": np.asarray(motion.angles, float),
         "root": np.asarray(motion.root, float),
-        "confidence": np.asarray(motion.confidence, float),
+        "confidence": np.asarray(_labelled_confidence(motion), float),
     }
     if track is not None:
         arrays["keypoints"] = np.asarray(track.xy, float)
@@ -507,6 +508,13 @@ def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = ""
     return path
 
 
+def _labelled_confidence(motion) -> np.ndarray | None:
+    """(T, J) a motion's joint confidence with its left/right identity's (:meth:`FitResult.labelled_confidence`)."""
+    if hasattr(motion, "labelled_confidence"):
+        return motion.labelled_confidence()
+    return getattr(motion, "confidence", None)
+
+
 def effort_sampler_options(fitted: bool) -> dict:
     """``sampler_kw`` of :func:`~capture2notation.effort.estimate_effort` for a fitted capture or a motion file."""
     from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
@@ -519,7 +527,7 @@ def _write_effort(outdir: Path, score: Score, motion, seed: int, workers: int = 
 
     result = estimate_effort(
         motion.joints,
-        motion.confidence,
+        _labelled_confidence(motion),
         motion.fps,
         score,
         rng=np.random.default_rng(seed),

@@ -52,7 +52,7 @@ from .solver import (
 from .spans import PROPORTION_FRAMES, spread_frames, stitch, track_spans
 from .start import SKIP_DIRECTIONS, image_offsets, initial_params, world_weights
 from .temporal import coupled_params, smooth_root
-from .uncertainty import direction_spread, spread_factor, with_identity_confidence
+from .uncertainty import direction_spread, spread_factor
 
 __all__ = ["TARGETS_2D", "fit_keypoints", "fit_track", "refine_focal"]
 
@@ -544,6 +544,12 @@ def fit_track(
         Passed to :func:`fit_keypoints`.  Without `options`, a BlazePose
         track has its world landmarks' rest offset removed
         (``DepthOptions(rest_offset=True)``).
+
+    Returns
+    -------
+    FitResult
+        With the track's ``identity_confidence`` (where it was assessed)
+        beside the joints' own confidence.
     """
     xy = np.asarray(track.xy, float)
     vis = np.asarray(track.visibility, float)
@@ -574,4 +580,4 @@ def fit_track(
     ident = getattr(track, "identity_confidence", None)
     if ident is None or not np.any(np.isfinite(ident)):
         return result
-    return replace(result, confidence=with_identity_confidence(result.confidence, ident))
+    return replace(result, identity_confidence=np.asarray(ident, dtype=float))

@@ -173,7 +173,8 @@ def fill_from_view(joints, jconf, missing, floor: float, visibility, fps: float,
     mono = SimpleNamespace(joints=np.full(np.shape(joints), np.nan), confidence=np.zeros(np.shape(jconf)))
     for w in fill_windows(missing, fps):
         fit = fit_window(view, w)
-        mono.joints[w], mono.confidence[w] = fit.joints, fit.confidence
+        labelled = fit.labelled_confidence() if hasattr(fit, "labelled_confidence") else fit.confidence
+        mono.joints[w], mono.confidence[w] = fit.joints, labelled
     return (view, *filled(joints, jconf, missing, mono, floor))
 
 

@@ -12,6 +12,9 @@ from ..errors import FittingError
 
 __all__ = ["FitResult"]
 
+#: Joints whose identity a left/right swap exchanges.
+_SIDED = np.array([name.startswith(("left_", "right_")) for name in JOINTS])
+
 
 @dataclass(frozen=True, eq=False)
 class FitResult:
@@ -37,6 +40,13 @@ class FitResult:
         Per-clip offsets of each joint from its parent, metres:
         ``forward_kinematics`` with these offsets reproduces `joints` exactly
         (``Body(height)`` proportions reproduce them approximately).
+    identity_confidence : (T,) ndarray or None
+        One view's fit: the probability, per frame, that the keypoints'
+        left and right were right (``KeypointTrack.identity_confidence``;
+        NaN where not assessed); None where nothing decided them (motion
+        files, several cameras).  `confidence` says how well each joint is
+        measured; :meth:`labelled_confidence` also that it is the side it
+        is called.
     front_readings : (T, 2) ndarray or None
         Where the front was decoded from one view's image
         (:func:`~capture2notation.fitting.yaw.with_image_yaw`): each frame's
@@ -54,6 +64,7 @@ class FitResult:
     confidence: np.ndarray
     offsets: np.ndarray | None = None
     front_readings: np.ndarray | None = None
+    identity_confidence: np.ndarray | None = None
 
     def __post_init__(self):
         T = np.shape(self.times)[0] if np.ndim(self.times) == 1 else -1
@@ -61,6 +72,8 @@ class FitResult:
         expect = {"joints": (T, J, 3), "angles": (T, J, 3), "root": (T, 3), "confidence": (T, J)}
         if self.front_readings is not None:
             expect["front_readings"] = (T, 2)
+        if self.identity_confidence is not None:
+            expect["identity_confidence"] = (T,)
         for name, shape in expect.items():
             if np.shape(getattr(self, name)) != shape:
                 raise FittingError(
@@ -78,6 +91,20 @@ class FitResult:
     def joint_names(self) -> tuple[str, ...]:
         """Names of the J joints (:data:`~capture2notation.body.JOINTS`)."""
         return JOINTS
+
+    def labelled_confidence(self) -> np.ndarray:
+        """(T, J) `confidence` times :attr:`identity_confidence` on every left and right joint.
+
+        What a symbol of a sided part rests on: the joint measured, and
+        under its own label (NaN identity leaves a frame as it is).
+        """
+        if self.identity_confidence is None:
+            return np.asarray(self.confidence, float)
+        ident = np.asarray(self.identity_confidence, float)
+        factor = np.where(np.isfinite(ident), np.clip(ident, 0.0, 1.0), 1.0)
+        out = np.array(self.confidence, dtype=float)
+        out[:, _SIDED] *= factor[:, None]
+        return out
 
     def replace(self, **changes):
         """A copy with some fields replaced."""

@@ -35,7 +35,7 @@ from .solver import (
     _subset,
 )
 
-__all__ = ["direction_spread", "spread_factor", "with_identity_confidence"]
+__all__ = ["direction_spread", "spread_factor"]
 
 _J = len(JOINTS)
 
@@ -81,21 +81,3 @@ def direction_spread(model: PoseModel, params: np.ndarray, terms: Terms, fps: fl
 def spread_factor(spread_deg: np.ndarray, scale_deg: float) -> np.ndarray:
     """Confidence factor ``1 / (1 + (σ / scale)²)`` in (0, 1] of an angular spread."""
     return 1.0 / (1.0 + (np.asarray(spread_deg, float) / scale_deg) ** 2)
-
-
-#: Joints whose identity a left/right swap exchanges.
-_SIDED = np.array([name.startswith(("left_", "right_")) for name in JOINTS])
-
-
-def with_identity_confidence(confidence: np.ndarray, identity: np.ndarray) -> np.ndarray:
-    """Joint confidence (T, J) times the track's identity confidence (T,) on sided joints.
-
-    A frame whose left and right could not be told apart lowers every left
-    and right joint's confidence by the probability that its label is right;
-    NaN (not assessed) leaves the confidence as it is.
-    """
-    ident = np.asarray(identity, dtype=float)
-    factor = np.where(np.isfinite(ident), np.clip(ident, 0.0, 1.0), 1.0)
-    out = np.array(confidence, dtype=float)
-    out[:, _SIDED] *= factor[:, None]
-    return out

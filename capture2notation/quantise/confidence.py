@@ -6,8 +6,9 @@ A symbol's confidence is the product of two factors, each in [0, 1]:
   the symbol (the part's segment ends, a bendable limb's middle joint; the
   legs for supports, the hips for turns) over the frames where the symbol
   arrives and holds — low where the keypoints were hidden or their left and
-  right could not be told apart (``KeypointTrack.identity_confidence``
-  is multiplied into every sided joint by ``fit_track``);
+  right could not be told apart (the capture passes
+  ``FitResult.labelled_confidence()``: the track's identity confidence on
+  every sided joint);
 * **direction**: the probability that the limb's true direction lies in the
   symbol's own cell (its 45° sector and its level, DESIGN.md) given the
   measured held direction, under this model of the fit's error: the

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from capture2notation.body import Body
-from capture2notation.fitting.uncertainty import with_identity_confidence
 from capture2notation.keypoints.identity import (
     IDENTITY_UNCERTAIN_BELOW,
     correct_identity,
@@ -131,9 +130,20 @@ def test_identity_confidence_out_of_range_is_refused():
 
 def test_identity_confidence_lowers_only_sided_joints():
     from capture2notation.body import JOINTS
+    from capture2notation.fitting import FitResult
 
-    conf = np.ones((3, len(JOINTS)))
-    out = with_identity_confidence(conf, np.array([0.25, np.nan, 1.0]))
+    T, J = 3, len(JOINTS)
+    fit = FitResult(
+        fps=25.0,
+        times=np.arange(T) / 25.0,
+        joints=np.zeros((T, J, 3)),
+        angles=np.zeros((T, J, 3)),
+        root=np.zeros((T, 3)),
+        confidence=np.ones((T, J)),
+        identity_confidence=np.array([0.25, np.nan, 1.0]),
+    )
+    out = fit.labelled_confidence()
+    np.testing.assert_allclose(fit.confidence, 1.0)  # the measurement itself is not lowered
     sided = [i for i, n in enumerate(JOINTS) if n.startswith(("left_", "right_"))]
     middle = [i for i, n in enumerate(JOINTS) if i not in sided]
     np.testing.assert_allclose(out[0, sided], 0.25)
