@@ -59,6 +59,13 @@ GRAVITY_MS2 = 9.81
 #: average (a ballistic pelvis: 1; a walk's pelvis: near 0 either way).
 BALLISTIC_FRACTION = 0.5
 _SUPPORT_PARTS = ("support", "right_support", "left_support")
+#: Measured motion: a fitted jump's feet can float a few centimetres before
+#: take-off and after the landing (its pliés), so both feet stay clear well
+#: beyond the flight and the pelvis over all of it is not ballistic.  Its
+#: core, where both feet clear this fraction of their highest, lies inside
+#: the flight (a free fall spends 71 % of its time above half its height),
+#: and a pelvis in free fall is ballistic over any part of its flight.
+CORE_FRACTION = 0.5
 
 
 def find_flights(
@@ -87,7 +94,8 @@ def find_flights(
     low, _ = foot_points(np.asarray(joints, float))
     ground = _local_floor(low, fps, floor) if measured else floor
     # Both feet clear of the floor; a frame with a foot not seen is unknown.
-    clear = np.all(np.stack([lo - ground >= SUPPORT_HEIGHT_M for lo in low]), axis=0)
+    clearance = np.min(np.stack([lo - ground for lo in low]), axis=0)
+    clear = clearance >= SUPPORT_HEIGHT_M
     known = np.ones(clear.shape, bool) if seen is None else np.asarray(seen, bool).all(axis=1)
     air = clear & known
     # A spinning jump hides a foot for a few frames: next to frames seen in
@@ -104,8 +112,26 @@ def find_flights(
             continue
         # Not ballistic as a whole: its seen airborne runs, each on its own.
         runs = [(a + c - 1, a + d) for c, d in true_runs(air[a:b])]
-        out += [(t0, t1) for t0, t1 in runs if _flight(joints, t0, t1, shortest, fps)]
+        found = [(t0, t1) for t0, t1 in runs if _flight(joints, t0, t1, shortest, fps)]
+        if not found and measured:
+            # Or the jump at its core, the feet's floating pliés left out.
+            c, d = _core(clearance[a:b])
+            if known[a + c : a + d].all() and _flight(joints, a + c - 1, a + d, shortest, fps):
+                found = [(a + c - 1, a + d)]
+        out += found
     return out
+
+
+def _core(clearance: np.ndarray) -> tuple[int, int]:
+    """The run ``[c, d)`` around the highest frame where `clearance` is at least :data:`CORE_FRACTION` of it."""
+    peak = int(np.argmax(clearance))
+    high = clearance >= CORE_FRACTION * clearance[peak]
+    c, d = peak, peak + 1
+    while c > 0 and high[c - 1]:
+        c -= 1
+    while d < high.size and high[d]:
+        d += 1
+    return c, d
 
 
 def _flight(joints: np.ndarray, t0: int, t1: int, shortest: int, fps: float) -> bool:

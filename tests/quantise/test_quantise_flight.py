@@ -165,3 +165,29 @@ def test_an_unseen_foot_makes_no_flight_and_a_hidden_landing_is_not_flown_throug
     two[15:20, joint_index("pelvis"), 2] = pelvis
     got = find_flights(two, FPS, measured=False, seen=seen)
     assert all(b - a < 15 for a, b in got) and len(got) == 2
+
+
+def test_a_fitted_jump_is_found_though_its_feet_float_in_the_plies():
+    """A single view's fitted feet can stand a few centimetres up in the
+    plié before a take-off and after a landing (a hop of a render through
+    BlazePose: 3.5-4 cm for half a second either side).  Both feet then stay
+    clear from the plié to the landing's, over which the pelvis is not
+    ballistic; the flight is found at its core, where the feet are highest."""
+    from capture2notation.body import joint_index
+    from capture2notation.quantise.flight import CORE_FRACTION, _core
+
+    _, clean, want = _spring_frames()
+    feet = [joint_index(f"{side}_{end}") for side in ("right", "left") for end in ("ankle", "toe")]
+    floating = clean.copy()
+    pad = int(0.5 * FPS)
+    for a, b in want:
+        floating[max(0, a - pad) : a + 1, feet, 2] += 0.04
+        floating[b : b + pad, feet, 2] += 0.04
+    got = find_flights(floating, FPS, measured=True)
+    assert len(got) == len(want)
+    for (a, b), (a0, b0) in zip(got, want, strict=True):
+        # Inside the written flight, by at most the part of a free fall
+        # below CORE_FRACTION of its height at either end.
+        assert a0 <= a and b <= b0 and (b - a) >= (1.0 - CORE_FRACTION) ** 0.5 * (b0 - a0) - 2
+    # The core is the run about the highest frame, not any other high stretch.
+    assert _core(np.array([0.0, 0.9, 0.1, 0.6, 1.0, 0.8, 0.2])) == (3, 6)
