@@ -116,7 +116,7 @@ def find_flights(
         if not found and measured:
             # Or the jump at its core, the feet's floating pliés left out.
             c, d = _core(clearance[a:b])
-            if known[a + c : a + d].all() and _flight(joints, a + c - 1, a + d, shortest, fps):
+            if _flight(joints, a + c - 1, a + d, shortest, fps):
                 found = [(a + c - 1, a + d)]
         out += found
     return out
