@@ -91,3 +91,26 @@ def chromium(tmp_path):
         ]
 
     return command
+
+
+@pytest.fixture
+def still_fit():
+    """``still_fit(confidence, identity_confidence=None)``: a motionless FitResult at 25 fps with these confidences."""
+    import numpy as np
+
+    from capture2notation.body import JOINTS
+    from capture2notation.fitting import FitResult
+
+    def make(confidence, identity_confidence=None):
+        T = len(confidence)
+        return FitResult(
+            fps=25.0,
+            times=np.arange(T) / 25.0,
+            joints=np.zeros((T, len(JOINTS), 3)),
+            angles=np.zeros((T, len(JOINTS), 3)),
+            root=np.zeros((T, 3)),
+            confidence=np.asarray(confidence, float),
+            identity_confidence=None if identity_confidence is None else np.asarray(identity_confidence, float),
+        )
+
+    return make

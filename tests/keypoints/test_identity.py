@@ -128,20 +128,10 @@ def test_identity_confidence_out_of_range_is_refused():
         KeypointTrack(**{**t.__dict__, "identity_confidence": np.array([0.5, 1.5])})
 
 
-def test_identity_confidence_lowers_only_sided_joints():
+def test_identity_confidence_lowers_only_sided_joints(still_fit):
     from capture2notation.body import JOINTS
-    from capture2notation.fitting import FitResult
 
-    T, J = 3, len(JOINTS)
-    fit = FitResult(
-        fps=25.0,
-        times=np.arange(T) / 25.0,
-        joints=np.zeros((T, J, 3)),
-        angles=np.zeros((T, J, 3)),
-        root=np.zeros((T, 3)),
-        confidence=np.ones((T, J)),
-        identity_confidence=np.array([0.25, np.nan, 1.0]),
-    )
+    fit = still_fit(np.ones((3, len(JOINTS))), [0.25, np.nan, 1.0])
     out = fit.labelled_confidence()
     np.testing.assert_allclose(fit.confidence, 1.0)  # the measurement itself is not lowered
     sided = [i for i, n in enumerate(JOINTS) if n.startswith(("left_", "right_"))]

@@ -33,28 +33,18 @@ def test_the_fit_takes_the_estimated_roll_beyond_its_noise(estimated, taken):
     assert _fit_roll(estimate) == pytest.approx(taken)
 
 
-def test_a_foot_is_seen_whatever_its_label():
+def test_a_foot_is_seen_whatever_its_label(still_fit):
     """Which foot is which may be in doubt (the pose model's left and right);
     that it is on the floor or in the air is not: the feet are seen on the
     fit's own confidence, not on the identity's."""
     import numpy as np
 
     from capture2notation.body import JOINTS, joint_index
-    from capture2notation.fitting import FitResult
     from pipelines.capture_input import FOOT_SEEN_CONFIDENCE, feet_seen
 
-    T, J = 4, len(JOINTS)
-    confidence = np.full((T, J), 0.9)
+    confidence = np.full((4, len(JOINTS)), 0.9)
     confidence[3, joint_index("left_toe")] = FOOT_SEEN_CONFIDENCE / 2  # not measured
-    fit = FitResult(
-        fps=25.0,
-        times=np.arange(T) / 25.0,
-        joints=np.zeros((T, J, 3)),
-        angles=np.zeros((T, J, 3)),
-        root=np.zeros((T, 3)),
-        confidence=confidence,
-        identity_confidence=np.array([1.0, 0.3, np.nan, 0.3]),
-    )
+    fit = still_fit(confidence, [1.0, 0.3, np.nan, 0.3])
     assert feet_seen(fit).tolist() == [[True, True], [True, True], [True, True], [True, False]]
     # The labels' doubt still reaches the symbols of sided parts.
     assert fit.labelled_confidence()[1, joint_index("left_toe")] == pytest.approx(0.27)
