@@ -59,6 +59,7 @@ from capture2notation.atomic import atomic_path, write_text
 from capture2notation.body import JOINTS
 from capture2notation.errors import C2NError, PipelineError, QuantiseError
 from capture2notation.fitting.motion import joints_for_labels
+from capture2notation.fitting.result import labelled_confidence
 from capture2notation.notation.model import Score
 from capture2notation.quantise.benesh import benesh_key_poses, write_benesh
 from capture2notation.quantise.confidence import score_confidence
@@ -370,7 +371,7 @@ def notate(
     if tempo == NO_TEMPO:
         seg = replace(seg, tempo_source=NO_TEMPO)
     # A symbol rests on its joints measured and under their own labels.
-    conf, readings = _labelled_confidence(motion), getattr(motion, "front_readings", None)
+    conf, readings = labelled_confidence(motion), getattr(motion, "front_readings", None)
     seg = replace(seg, score=score_confidence(seg.score, joints, fps, conf, line_of_sight, readings))
     seconds["quantise"] = time.perf_counter() - t0
     how = tempo_note(seg, sound)
@@ -491,7 +492,7 @@ def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = ""
         "joints": np.asarray(motion.joints, float),
         "angles": np.asarray(motion.angles, float),
         "root": np.asarray(motion.root, float),
-        "confidence": np.asarray(_labelled_confidence(motion), float),
+        "confidence": np.asarray(labelled_confidence(motion), float),
     }
     if track is not None:
         arrays["keypoints"] = np.asarray(track.xy, float)
@@ -508,13 +509,6 @@ def _write_npz(path: Path, motion, track, estimate=None, camera_source: str = ""
     return path
 
 
-def _labelled_confidence(motion) -> np.ndarray | None:
-    """(T, J) a motion's joint confidence with its left/right identity's (:meth:`FitResult.labelled_confidence`)."""
-    if hasattr(motion, "labelled_confidence"):
-        return motion.labelled_confidence()
-    return getattr(motion, "confidence", None)
-
-
 def effort_sampler_options(fitted: bool) -> dict:
     """``sampler_kw`` of :func:`~capture2notation.effort.estimate_effort` for a fitted capture or a motion file."""
     from capture2notation.effort.likelihood import CAPTURE_RHO_RANGE
@@ -527,7 +521,7 @@ def _write_effort(outdir: Path, score: Score, motion, seed: int, workers: int = 
 
     result = estimate_effort(
         motion.joints,
-        _labelled_confidence(motion),
+        labelled_confidence(motion),
         motion.fps,
         score,
         rng=np.random.default_rng(seed),

@@ -21,7 +21,7 @@ from ..errors import C2NError, FittingError
 from .camera import Camera
 from .fit3d import fit_points3d
 from .motion import floor_height
-from .result import FitResult
+from .result import FitResult, labelled_confidence
 from .triangulate import (
     LANDMARK_TARGETS,
     MEASURED_JOINTS,
@@ -173,8 +173,7 @@ def fill_from_view(joints, jconf, missing, floor: float, visibility, fps: float,
     mono = SimpleNamespace(joints=np.full(np.shape(joints), np.nan), confidence=np.zeros(np.shape(jconf)))
     for w in fill_windows(missing, fps):
         fit = fit_window(view, w)
-        labelled = fit.labelled_confidence() if hasattr(fit, "labelled_confidence") else fit.confidence
-        mono.joints[w], mono.confidence[w] = fit.joints, labelled
+        mono.joints[w], mono.confidence[w] = fit.joints, labelled_confidence(fit)
     return (view, *filled(joints, jconf, missing, mono, floor))
 
 

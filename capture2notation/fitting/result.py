@@ -10,7 +10,7 @@ import numpy as np
 from ..body import JOINTS
 from ..errors import FittingError
 
-__all__ = ["FitResult"]
+__all__ = ["FitResult", "labelled_confidence"]
 
 #: Joints whose identity a left/right swap exchanges.
 _SIDED = np.array([name.startswith(("left_", "right_")) for name in JOINTS])
@@ -109,3 +109,14 @@ class FitResult:
     def replace(self, **changes):
         """A copy with some fields replaced."""
         return dataclasses.replace(self, **changes)
+
+
+def labelled_confidence(motion) -> np.ndarray | None:
+    """(T, J) any motion's joint confidence under its own labels: :meth:`FitResult.labelled_confidence`.
+
+    An object with only ``confidence`` (a fit window of a test, say) gives
+    that; one without it, None.
+    """
+    if isinstance(motion, FitResult):
+        return motion.labelled_confidence()
+    return getattr(motion, "confidence", None)

@@ -349,7 +349,7 @@ def _feet_turn_too(
     """
     hi = feet.shape[0] - 1 if hi is None else hi
     before = np.nanmedian(feet[max(min(lo, a), a - window + 1) : a + 1], axis=0)
-    after = np.nanmedian(feet[b : max(b, min(b + window - 1, hi)) + 1], axis=0)
+    after = np.nanmedian(feet[b : max(b + 1, min(b + window, hi + 1))], axis=0)
     d = after - before
     if not np.isfinite(d).any():
         return True
