@@ -18,8 +18,10 @@ after the feet's reading and after each arm and leg pair's side-on reading
 (:func:`capture2notation.keypoints.near_side.correct_near_side`; all as
 ``extract`` applies them), scored against the renderer's keypoints, and
 the same for the shoulders and hips alone (the body's own left and right,
-each arm and leg apart).  With ``--back-turns DIR``, the issue's own case:
-six clips of slow turns on both feet through a back view, arms held.
+each arm and leg apart), and the frames the capture marks uncertain in
+the end with how often they are wrong against the rest.  With
+``--back-turns DIR``, the issue's own case: six clips of slow turns on
+both feet through a back view, arms held.
 
 Run: ``nice -n 10 .venv/bin/python benchmarks/bench_identity.py [--clips N] [--seed S] [--render DIR --renders N [--view V]]``
 """
@@ -32,7 +34,7 @@ from fractions import Fraction
 import numpy as np
 
 from capture2notation.body import Body
-from capture2notation.keypoints.identity import correct_identity
+from capture2notation.keypoints.identity import IDENTITY_UNCERTAIN_BELOW, correct_identity
 from capture2notation.keypoints.near_side import correct_near_side
 from capture2notation.keypoints.yaw import correct_mirrored
 from capture2notation.notation.model import Score, Symbol
@@ -113,7 +115,12 @@ def _through_blazepose(score, out, view: str, fields, camera) -> tuple[np.ndarra
         f"{1 - torso[0].mean():.1%} -> {1 - torso[3].mean():.1%}); decoded facing right "
         f"{face_ok.mean():.1%} off side views; uncertain {res.uncertain.mean():.1%}"
     )
-    counts = [len(raw), *((~w).sum() for w in wrong), face_ok.sum(), off.sum(), (~torso[0]).sum(), (~torso[3]).sum()]
+    # What the capture marks uncertain in the end: those frames should be the wrong ones.
+    doubt = np.asarray(limbs.identity_confidence, float) < IDENTITY_UNCERTAIN_BELOW
+    counts = [
+        len(raw), *((~w).sum() for w in wrong), face_ok.sum(), off.sum(), (~torso[0]).sum(), (~torso[3]).sum(),
+        doubt.sum(), (doubt & wrong[3]).sum(),
+    ]  # fmt: skip
     return np.array(counts, float), line
 
 
@@ -126,6 +133,13 @@ def _print_totals(label: str, done: int, tot: np.ndarray) -> None:
     print(
         f"{label} shoulders and hips (the body's own left and right, each arm and leg apart): right as read "
         f"{tot[7] / tot[0]:.1%}, after every correction {tot[8] / tot[0]:.1%}"
+    )
+    doubt, wrong = tot[9], tot[0] - tot[4]
+    sure = tot[0] - doubt
+    print(
+        f"{label} marked uncertain in the end: {doubt / tot[0]:.1%} of frames, wrong there "
+        f"{tot[10] / max(doubt, 1):.1%} against {(wrong - tot[10]) / max(sure, 1):.1%} elsewhere "
+        f"(right among the frames not marked: {1 - (wrong - tot[10]) / max(sure, 1):.1%})"
     )
 
 
@@ -141,7 +155,7 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16, view: str =
     """
     from pathlib import Path
 
-    tot = np.zeros(9)
+    tot = np.zeros(11)
     s, done = seed, 0
     while done < n_clips and s < seed + 40 * n_clips:
         score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
@@ -188,7 +202,7 @@ def back_turns(outdir, view: str = "front") -> None:
     """The issue's case: slow turns on both feet through a back view (:data:`BACK_TURN_ARMS`), through BlazePose."""
     from pathlib import Path
 
-    tot = np.zeros(9)
+    tot = np.zeros(11)
     for i, (right_arm, left_arm, way, tempo) in enumerate(BACK_TURN_ARMS):
         score = back_turn_score(right_arm, left_arm, way, tempo)
         pose = Pose.from_motion(interpret(score, 25.0, Body()))
