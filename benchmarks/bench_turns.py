@@ -21,7 +21,10 @@ Printed (never asserted):
   within 1/8, direction), each flight ≥ 0.3 s matched to a captured flight,
   and the agreement on every column but the front (gestures, supports).
   ``--no-turns`` renders scores without turns instead: the same agreement
-  on phrases that do not turn.
+  on phrases that do not turn.  ``--keypoints render`` captures each clip
+  from the renderer's own landmarks instead of BlazePose's (``render-2d``:
+  its pixels on BlazePose's 3D landmarks), the video's face cue kept: what
+  the capture makes of perfect keypoints.
 * ``--speed`` (alone): time and peak memory of the room-direction decoder
   (``quantise.front_levels``) on 1-, 10- and 60-minute measured fronts.
 """
@@ -156,7 +159,37 @@ def bvh() -> None:
         )
 
 
-def video(n: int, seed0: int = 20261400, turns: bool = True) -> None:
+#: What each ``--keypoints`` mode captures from.
+KEYPOINTS = {
+    "blazepose": "BlazePose",
+    "render": "the renderer's landmarks",
+    "render-2d": "the renderer's pixels on BlazePose's 3D",
+}
+
+
+def _oracle_track(render: Path, keypoints: str):
+    """The track a ``--keypoints`` mode captures: the renderer's landmarks, or its pixels on BlazePose's 3D.
+
+    The video's face cue is kept either way: the yaw decoder reads it from
+    the frames, not from the landmarks.
+    """
+    import dataclasses
+
+    from bench_wholepath import render_track
+
+    from capture2notation.io.truth import read_truth
+    from capture2notation.keypoints import extract
+
+    read = extract(render / "video.mp4", progress=False)
+    perfect = render_track(read_truth(render / "truth.npz"))
+    if keypoints == "render":
+        return dataclasses.replace(perfect, face=read.face)
+    xy = np.array(read.xy, float)
+    xy[..., :2] = perfect.xy[..., :2]  # BlazePose's own image depth (column 2) stays
+    return dataclasses.replace(read, xy=xy)
+
+
+def video(n: int, seed0: int = 20261400, turns: bool = True, keypoints: str = "blazepose") -> None:
     import synthetic.random_scores as rs
     from capture2notation.compare.agreement import agreement_cells, compare_scores
     from capture2notation.errors import C2NError
@@ -185,10 +218,12 @@ def video(n: int, seed0: int = 20261400, turns: bool = True) -> None:
             render = render_score(
                 score, work / "render", fps=25.0, size=(640, 480), view="front", style="mannequin", progress=False
             )
+            source = render / "video.mp4"
+            if keypoints != "blazepose":
+                source = work / "keypoints.npz"
+                _oracle_track(render, keypoints).save(source)
             try:
-                cap = capture(
-                    render / "video.mp4", work / "video", progress=False, effort=False, overlay=False, tempo=score.tempo
-                )
+                cap = capture(source, work / "video", progress=False, effort=False, overlay=False, tempo=score.tempo)
             except C2NError as exc:  # counted: every turn and flight of the clip missed
                 failed += 1
                 turns_all += sum(s.is_turn for s in score.symbols)
@@ -219,7 +254,8 @@ def video(n: int, seed0: int = 20261400, turns: bool = True) -> None:
                 f"{time.perf_counter() - t0:.0f} s"
             )
     print(
-        f"video ({n} scores {'with' if turns else 'without'} turns, front, 640x480, 25 fps, BlazePose, tempo given): "
+        f"video ({n} scores {'with' if turns else 'without'} turns, front, 640x480, 25 fps, {KEYPOINTS[keypoints]}, "
+        f"tempo given): "
         f"turns within 1/8 and the right way {turns_ok}/{turns_all}; flights >= 0.3 s found "
         f"{flights_ok}/{flights_all}; captures failed {failed}"
     )
@@ -279,6 +315,10 @@ def main() -> None:
         "--no-turns", action="store_true", help="--video scores without turns: the control for the other columns"
     )
     ap.add_argument("--skip-bvh", action="store_true")
+    ap.add_argument(
+        "--keypoints", choices=tuple(KEYPOINTS), default="blazepose",
+        help="--video clips captured from BlazePose (default) or from the renderer's landmarks",
+    )  # fmt: skip
     ap.add_argument("--speed", action="store_true", help="time and memory of the turn decoder on 1-60 min fronts")
     args = ap.parse_args()
     if args.speed:
@@ -290,7 +330,7 @@ def main() -> None:
     if not args.skip_bvh:
         bvh()
     if args.video:
-        video(args.video, args.video_seed0, turns=not args.no_turns)
+        video(args.video, args.video_seed0, turns=not args.no_turns, keypoints=args.keypoints)
 
 
 if __name__ == "__main__":
