@@ -168,25 +168,23 @@ KEYPOINTS = {
 
 
 def _oracle_track(render: Path, keypoints: str):
-    """The track a ``--keypoints`` mode captures: the renderer's landmarks, or its pixels on BlazePose's 3D.
+    """The track a ``--keypoints`` mode captures (``bench_wholepath``'s modes), the video's face cue kept.
 
-    The video's face cue is kept either way: the yaw decoder reads it from
-    the frames, not from the landmarks.
+    The yaw decoder reads the face from the frames, not from the landmarks,
+    so the renderer's landmarks take BlazePose's reading of it.
     """
     import dataclasses
 
-    from bench_wholepath import render_track
+    from bench_wholepath import _keypoint_track
 
     from capture2notation.io.truth import read_truth
     from capture2notation.keypoints import extract
 
-    read = extract(render / "video.mp4", progress=False)
-    perfect = render_track(read_truth(render / "truth.npz"))
+    video = render / "video.mp4"
+    track = _keypoint_track(read_truth(render / "truth.npz"), keypoints, video)
     if keypoints == "render":
-        return dataclasses.replace(perfect, face=read.face)
-    xy = np.array(read.xy, float)
-    xy[..., :2] = perfect.xy[..., :2]  # BlazePose's own image depth (column 2) stays
-    return dataclasses.replace(read, xy=xy)
+        track = dataclasses.replace(track, face=extract(video, progress=False).face)
+    return track
 
 
 def video(n: int, seed0: int = 20261400, turns: bool = True, keypoints: str = "blazepose") -> None:
