@@ -87,7 +87,8 @@ def _through_blazepose(score, out, view: str, fields, camera) -> tuple[np.ndarra
     Returns the clip's counts (frames; right identity as read, after
     :func:`correct_identity`, :func:`correct_mirrored`,
     :func:`correct_near_side`; decoded facing right and frames off side
-    views; shoulders and hips right as read and at the end) and its line.
+    views; shoulders and hips right as read and at the end; frames marked
+    uncertain at the end, and those of them wrong) and its line.
     """
     from capture2notation.io.truth import read_truth
     from capture2notation.keypoints import extract
@@ -155,9 +156,9 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16, view: str =
     """
     from pathlib import Path
 
-    tot = np.zeros(11)
-    s, done = seed, 0
-    while done < n_clips and s < seed + 40 * n_clips:
+    rows = []
+    s = seed
+    while len(rows) < n_clips and s < seed + 40 * n_clips:
         score = random_score(np.random.default_rng(s), n_beats=n_beats, turns=True, fps=25.0)
         pose = Pose.from_motion(interpret(score, 25.0, Body()))
         camera = Camera.for_view(view, (640, 480), pose.body.height)
@@ -167,10 +168,9 @@ def rendered(seed: int, outdir, n_clips: int = 1, n_beats: int = 16, view: str =
             continue
         counts, line = _through_blazepose(score, Path(outdir) / f"r{s - 1}", view, fields, camera)
         print(f"render seed {s - 1} {line}")
-        tot += counts
-        done += 1
-    if done:
-        _print_totals("RENDERS", done, tot)
+        rows.append(counts)
+    if rows:
+        _print_totals("RENDERS", len(rows), np.sum(rows, axis=0))
 
 
 #: The issue's own case: a dancer turning slowly on both feet through a back
@@ -202,15 +202,15 @@ def back_turns(outdir, view: str = "front") -> None:
     """The issue's case: slow turns on both feet through a back view (:data:`BACK_TURN_ARMS`), through BlazePose."""
     from pathlib import Path
 
-    tot = np.zeros(11)
+    rows = []
     for i, (right_arm, left_arm, way, tempo) in enumerate(BACK_TURN_ARMS):
         score = back_turn_score(right_arm, left_arm, way, tempo)
         pose = Pose.from_motion(interpret(score, 25.0, Body()))
         camera = Camera.for_view(view, (640, 480), pose.body.height)
         counts, line = _through_blazepose(score, Path(outdir) / f"back{i}", view, truth_fields(pose, camera), camera)
         print(f"turn through a back view {i} {line}")
-        tot += counts
-    _print_totals("BACK TURNS", len(BACK_TURN_ARMS), tot)
+        rows.append(counts)
+    _print_totals("BACK TURNS", len(rows), np.sum(rows, axis=0))
 
 
 def main(argv=None) -> None:
