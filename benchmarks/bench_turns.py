@@ -21,7 +21,9 @@ Printed (never asserted):
   within 1/8, direction), each flight ≥ 0.3 s matched to a captured flight,
   and the agreement on every column but the front (gestures, supports).
   ``--no-turns`` renders scores without turns instead: the same agreement
-  on phrases that do not turn.  ``--keypoints render`` captures each clip
+  on phrases that do not turn.  Several ``--video-seed0`` values give a
+  set of N scores from each and the figures of their pool too.
+  ``--keypoints render`` captures each clip
   from the renderer's own landmarks instead of BlazePose's (``render-2d``:
   its pixels on BlazePose's 3D landmarks), the video's face cue kept: what
   the capture makes of perfect keypoints.
@@ -187,7 +189,19 @@ def _oracle_track(render: Path, keypoints: str):
     return track
 
 
-def video(n: int, seed0: int = 20261400, turns: bool = True, keypoints: str = "blazepose") -> None:
+def video(n: int, seed0s=(20261400,), turns: bool = True, keypoints: str = "blazepose") -> None:
+    """``--video``: n random scores from each first seed in `seed0s`, each set's figures and, for several, their pool."""
+    pooled = collections.Counter()
+    for seed0 in seed0s:
+        counts = _video_set(n, seed0, turns, keypoints)
+        _print_video(counts, f"video ({n} scores from seed {seed0}", turns, keypoints)
+        pooled.update(counts)
+    if len(seed0s) > 1:
+        _print_video(pooled, f"POOLED ({len(seed0s)} sets of {n} scores", turns, keypoints)
+
+
+def _video_set(n: int, seed0: int, turns: bool, keypoints: str) -> collections.Counter:
+    """Render, capture and match one set of `n` scores (printing a line per clip); its counts."""
     import synthetic.random_scores as rs
     from capture2notation.compare.agreement import agreement_cells, compare_scores
     from capture2notation.errors import C2NError
@@ -195,9 +209,7 @@ def video(n: int, seed0: int = 20261400, turns: bool = True, keypoints: str = "b
     from pipelines.capture import capture
     from synthetic.render import render_score
 
-    turns_ok = turns_all = flights_ok = flights_all = failed = 0
-    captured = []  # (uncertain, right) of every captured turn: how the confidence ranks them
-    others = [0, 0]  # cells of the columns other than the front (gestures, supports): agreeing, all
+    c = collections.Counter()
 
     def long_flight(s, score) -> bool:  # the flights counted: at least MIN_FLIGHT_S at the score's tempo
         return s.is_air and float(s.duration) * 60 / float(score.tempo) >= MIN_FLIGHT_S
@@ -223,51 +235,60 @@ def video(n: int, seed0: int = 20261400, turns: bool = True, keypoints: str = "b
             try:
                 cap = capture(source, work / "video", progress=False, effort=False, overlay=False, tempo=score.tempo)
             except C2NError as exc:  # counted: every turn and flight of the clip missed
-                failed += 1
-                turns_all += sum(s.is_turn for s in score.symbols)
-                flights_all += sum(long_flight(s, score) for s in score.symbols)
+                c["failed"] += 1
+                c["turns"] += sum(s.is_turn for s in score.symbols)
+                c["flights"] += sum(long_flight(s, score) for s in score.symbols)
                 print(f"  video seed {seed0 + i}: capture FAILED: {exc}")
                 continue
             got = cap.score
             for s in score.symbols:
                 if s.is_turn:
-                    turns_all += 1
-                    turns_ok += any(same_turn(s, c) for c in got.symbols)
+                    c["turns"] += 1
+                    c["turns_ok"] += any(same_turn(s, g) for g in got.symbols)
                 if long_flight(s, score):
-                    flights_all += 1
-                    flights_ok += any(c.is_air and c.start <= s.end and s.start <= c.end for c in got.symbols)
-            for c in got.symbols:
-                if c.is_turn:
-                    uncertain = c.confidence is not None and c.confidence < SYMBOL_UNCERTAIN_BELOW
-                    captured.append((uncertain, any(same_turn(s, c) for s in score.symbols)))
-            a = compare_scores(score, got)
-            cells = [c for c in agreement_cells(score, got) if c.part != "front"]
-            others[0] += sum(c.ref == c.cand for c in cells)
-            others[1] += len(cells)
+                    c["flights"] += 1
+                    c["flights_ok"] += any(g.is_air and g.start <= s.end and s.start <= g.end for g in got.symbols)
+            # How the confidence ranks the captured turns: uncertain ones should be the wrong ones.
+            for g in got.symbols:
+                if g.is_turn:
+                    uncertain = g.confidence is not None and g.confidence < SYMBOL_UNCERTAIN_BELOW
+                    right = any(same_turn(s, g) for s in score.symbols)
+                    c["captured"] += 1
+                    c["captured_ok"] += right
+                    c["uncertain"] += uncertain
+                    c["uncertain_wrong"] += uncertain and not right
+            others = [x for x in agreement_cells(score, got) if x.part != "front"]  # gestures, supports
+            c["other_cells"] += len(others)
+            c["other_ok"] += sum(x.ref == x.cand for x in others)
             print(
-                f"  video seed {seed0 + i}: agreement {a.symbol_agreement:.3f}, turns written "
-                f"{[(s.direction, str(s.amount)) for s in score.symbols if s.is_turn]} captured "
+                f"  video seed {seed0 + i}: agreement {compare_scores(score, got).symbol_agreement:.3f}, "
+                f"turns written {[(s.direction, str(s.amount)) for s in score.symbols if s.is_turn]} captured "
                 f"{[(s.direction, str(s.amount)) for s in got.symbols if s.is_turn]}, "
                 f"flights {sum(s.is_air for s in score.symbols)} -> {sum(s.is_air for s in got.symbols)}, "
                 f"{time.perf_counter() - t0:.0f} s"
             )
+    return c
+
+
+def _print_video(c: collections.Counter, label: str, turns: bool, keypoints: str) -> None:
+    """The figures of one set's (or a pool's) counts from :func:`_video_set`."""
     print(
-        f"video ({n} scores {'with' if turns else 'without'} turns, front, 640x480, 25 fps, {KEYPOINTS[keypoints]}, "
-        f"tempo given): "
-        f"turns within 1/8 and the right way {turns_ok}/{turns_all}; flights >= 0.3 s found "
-        f"{flights_ok}/{flights_all}; captures failed {failed}"
+        f"{label} {'with' if turns else 'without'} turns, front, 640x480, 25 fps, {KEYPOINTS[keypoints]}, "
+        f"tempo given): turns within 1/8 and the right way {c['turns_ok']}/{c['turns']}; flights >= 0.3 s found "
+        f"{c['flights_ok']}/{c['flights']}; captures failed {c['failed']}"
     )
     print(
         f"agreement on the columns other than the front (gestures, supports): "
-        f"{others[0] / max(others[1], 1):.3f} of {others[1]} cells"
+        f"{c['other_ok'] / max(c['other_cells'], 1):.3f} of {c['other_cells']} cells"
     )
-    if captured:
-        unc, right = np.array(captured, bool).T
-        wrong_unc = 1.0 - right[unc].mean() if unc.any() else float("nan")
-        wrong_conf = 1.0 - right[~unc].mean() if (~unc).any() else float("nan")
+    if c["captured"]:
+        n_unc, n_sure = c["uncertain"], c["captured"] - c["uncertain"]
+        wrong_unc = c["uncertain_wrong"] / n_unc if n_unc else float("nan")
+        wrong_sure = (c["captured"] - c["captured_ok"] - c["uncertain_wrong"]) / n_sure if n_sure else float("nan")
         print(
-            f"captured turns {len(right)}, right {right.mean():.0%}; marked uncertain {unc.sum()}: wrong "
-            f"{wrong_unc:.0%} against {wrong_conf:.0%} of the others (ratio {wrong_unc / max(wrong_conf, 1e-9):.1f})"
+            f"captured turns {c['captured']}, right {c['captured_ok'] / c['captured']:.0%}; marked uncertain {n_unc}: "
+            f"wrong {wrong_unc:.0%} against {wrong_sure:.0%} of the others "
+            f"(ratio {wrong_unc / max(wrong_sure, 1e-9):.1f})"
         )
 
 
@@ -308,7 +329,10 @@ def main() -> None:
         "--seed0", type=int, default=20260000, help="first seed (development: 20260000; fresh: e.g. 20270000)"
     )
     ap.add_argument("--video", type=int, default=0, help="random scores to render and capture from video")
-    ap.add_argument("--video-seed0", type=int, default=20261400, help="first seed of the --video scores")
+    ap.add_argument(
+        "--video-seed0", type=int, nargs="+", default=[20261400],
+        help="first seed of the --video scores; several: a set of --video scores from each, and their pool",
+    )  # fmt: skip
     ap.add_argument(
         "--no-turns", action="store_true", help="--video scores without turns: the control for the other columns"
     )
@@ -328,7 +352,7 @@ def main() -> None:
     if not args.skip_bvh:
         bvh()
     if args.video:
-        video(args.video, args.video_seed0, turns=not args.no_turns, keypoints=args.keypoints)
+        video(args.video, tuple(args.video_seed0), turns=not args.no_turns, keypoints=args.keypoints)
 
 
 if __name__ == "__main__":
