@@ -26,7 +26,9 @@ Printed (never asserted):
   ``--keypoints render`` captures each clip
   from the renderer's own landmarks instead of BlazePose's (``render-2d``:
   its pixels on BlazePose's 3D landmarks), the video's face cue kept: what
-  the capture makes of perfect keypoints.
+  the capture makes of perfect keypoints; ``--flip-test`` reads each clip
+  with BlazePose's flip test (the mirrored crop averaged in), and
+  ``$C2N_POSE_MODEL`` picks another BlazePose model.
 * ``--speed`` (alone): time and peak memory of the room-direction decoder
   (``quantise.front_levels``) on 1-, 10- and 60-minute measured fronts.
 """
@@ -189,18 +191,20 @@ def _oracle_track(render: Path, keypoints: str):
     return track
 
 
-def video(n: int, seed0s=(20261400,), turns: bool = True, keypoints: str = "blazepose") -> None:
+def video(
+    n: int, seed0s=(20261400,), turns: bool = True, keypoints: str = "blazepose", flip_test: bool = False
+) -> None:
     """``--video``: n random scores from each first seed in `seed0s`, each set's figures and, for several, their pool."""
     pooled = collections.Counter()
     for seed0 in seed0s:
-        counts = _video_set(n, seed0, turns, keypoints)
+        counts = _video_set(n, seed0, turns, keypoints, flip_test)
         _print_video(counts, f"video ({n} scores from seed {seed0}", turns, keypoints)
         pooled.update(counts)
     if len(seed0s) > 1:
         _print_video(pooled, f"POOLED ({len(seed0s)} sets of {n} scores", turns, keypoints)
 
 
-def _video_set(n: int, seed0: int, turns: bool, keypoints: str) -> collections.Counter:
+def _video_set(n: int, seed0: int, turns: bool, keypoints: str, flip_test: bool = False) -> collections.Counter:
     """Render, capture and match one set of `n` scores (printing a line per clip); its counts."""
     import synthetic.random_scores as rs
     from capture2notation.compare.agreement import agreement_cells, compare_scores
@@ -233,7 +237,10 @@ def _video_set(n: int, seed0: int, turns: bool, keypoints: str) -> collections.C
                 source = work / "keypoints.npz"
                 _oracle_track(render, keypoints).save(source)
             try:
-                cap = capture(source, work / "video", progress=False, effort=False, overlay=False, tempo=score.tempo)
+                cap = capture(
+                    source, work / "video", progress=False, effort=False, overlay=False, tempo=score.tempo,
+                    flip_test=flip_test,
+                )  # fmt: skip
             except C2NError as exc:  # counted: every turn and flight of the clip missed
                 c["failed"] += 1
                 c["turns"] += sum(s.is_turn for s in score.symbols)
@@ -341,6 +348,7 @@ def main() -> None:
         "--keypoints", choices=tuple(KEYPOINTS), default="blazepose",
         help="--video clips captured from BlazePose (default) or from the renderer's landmarks",
     )  # fmt: skip
+    ap.add_argument("--flip-test", action="store_true", help="--video clips read by BlazePose with its flip test")
     ap.add_argument("--speed", action="store_true", help="time and memory of the turn decoder on 1-60 min fronts")
     args = ap.parse_args()
     if args.speed:
@@ -352,7 +360,10 @@ def main() -> None:
     if not args.skip_bvh:
         bvh()
     if args.video:
-        video(args.video, tuple(args.video_seed0), turns=not args.no_turns, keypoints=args.keypoints)
+        video(
+            args.video, tuple(args.video_seed0), turns=not args.no_turns, keypoints=args.keypoints,
+            flip_test=args.flip_test,
+        )  # fmt: skip
 
 
 if __name__ == "__main__":
