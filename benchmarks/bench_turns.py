@@ -198,10 +198,10 @@ def video(
     pooled = collections.Counter()
     for seed0 in seed0s:
         counts = _video_set(n, seed0, turns, keypoints, flip_test)
-        _print_video(counts, f"video ({n} scores from seed {seed0}", turns, keypoints)
+        _print_video(counts, f"video, {n} scores from seed {seed0}", turns, keypoints)
         pooled.update(counts)
     if len(seed0s) > 1:
-        _print_video(pooled, f"POOLED ({len(seed0s)} sets of {n} scores", turns, keypoints)
+        _print_video(pooled, f"POOLED, {len(seed0s)} sets of {n} scores", turns, keypoints)
 
 
 def _video_set(n: int, seed0: int, turns: bool, keypoints: str, flip_test: bool = False) -> collections.Counter:
@@ -280,7 +280,7 @@ def _video_set(n: int, seed0: int, turns: bool, keypoints: str, flip_test: bool 
 def _print_video(c: collections.Counter, label: str, turns: bool, keypoints: str) -> None:
     """The figures of one set's (or a pool's) counts from :func:`_video_set`."""
     print(
-        f"{label} {'with' if turns else 'without'} turns, front, 640x480, 25 fps, {KEYPOINTS[keypoints]}, "
+        f"{label} ({'with' if turns else 'without'} turns, front, 640x480, 25 fps, {KEYPOINTS[keypoints]}, "
         f"tempo given): turns within 1/8 and the right way {c['turns_ok']}/{c['turns']}; flights >= 0.3 s found "
         f"{c['flights_ok']}/{c['flights']}; captures failed {c['failed']}"
     )
