@@ -80,11 +80,13 @@ def extract_frames(
         and correct the track (:func:`~.identity.correct_identity`, then
         :func:`~.yaw.correct_mirrored` from the feet and the turning, then
         each arm and leg pair side-on, :func:`~.near_side.correct_near_side`,
-        unless `limbs` is off), which sets ``identity_confidence``; otherwise
-        it is NaN (not assessed).
+        and each pair drawn on top of itself,
+        :func:`~.overlap.correct_overlapping`, unless `limbs` is off), which
+        sets ``identity_confidence``; otherwise it is NaN (not assessed).
     limbs : bool
         With `identity`: also decide each arm and leg pair side-on from the
-        pose model's visibility.  Several calibrated cameras decide the limbs
+        pose model's visibility, and each overlapping pair from its
+        neighbours.  Several calibrated cameras decide the limbs
         by their geometry instead (:func:`~capture2notation.fitting.triangulate.match_sides`),
         which the visibility only disturbs, so their captures turn it off.
     faces : bool
@@ -171,12 +173,14 @@ def extract_frames(
     if identity and track.backend == "blazepose":
         from .identity import correct_identity
         from .near_side import correct_near_side
+        from .overlap import correct_overlapping
         from .yaw import correct_mirrored
 
         track, _ = correct_identity(track)
         track, decoding = correct_mirrored(track)
         if limbs:
             track, _ = correct_near_side(track, decoding.yaw)
+            track, _ = correct_overlapping(track, decoding.yaw)
     return track
 
 
