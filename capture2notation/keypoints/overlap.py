@@ -140,5 +140,5 @@ def correct_overlapping(track: KeypointTrack, yaw) -> tuple[KeypointTrack, dict[
     fixed = track
     for name, exchange in frames.items():
         if exchange.any():
-            fixed = mirror_frames(fixed, exchange, fixed.identity_confidence, pairs=_PAIRS[name])
+            fixed = mirror_frames(fixed, exchange, np.asarray(fixed.identity_confidence, float), pairs=_PAIRS[name])
     return fixed, frames
