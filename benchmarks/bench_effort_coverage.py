@@ -173,15 +173,29 @@ def reliability(test: list, temperature: float) -> None:
     print(
         f"  accuracy {100 * right.mean():.1f} %  (chance 25 %); read by the domain check: {100 * inside.mean():.1f} %"
     )
-    print("  claim bin     n   mean claim   right")
+    print("  claim bin     n   mean claim   right   (90 % interval of right)")
+    gap = 0.0
     for lo, hi in ((0.25, 0.5), (0.5, 0.7), (0.7, 0.9), (0.9, 1.0001)):
         m = (claim >= lo) & (claim < hi)
         if m.any():
+            low, high = _wilson(int(right[m].sum()), int(m.sum()))
+            gap += m.sum() * abs(claim[m].mean() - right[m].mean())
             print(
                 f"  {lo:.2f}-{min(hi, 1):.2f}  {m.sum():4d}   {100 * claim[m].mean():8.1f} %  {100 * right[m].mean():5.1f} %"
+                f"   ({100 * low:.1f}-{100 * high:.1f} %)"
             )
     nll = -np.mean(np.log(p[np.arange(len(truth)), truth] + 1e-300))
-    print(f"  mean -ln p(true emotion) {nll:.3f}")
+    print(
+        f"  mean -ln p(true emotion) {nll:.3f}; claim minus right, weighted over the bins {100 * gap / len(test):.1f} points"
+    )
+
+
+def _wilson(k: int, n: int, z: float = 1.645) -> tuple[float, float]:
+    """Wilson score interval of a proportion k/n at 90 % (z = 1.645)."""
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return centre - half, centre + half
 
 
 def main(argv=None) -> None:
